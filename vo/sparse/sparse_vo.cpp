@@ -5,6 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include <opencv2/video/tracking.hpp>
+
 #include "core/error.hpp"
 #include "vo/sparse/circle_matcher.hpp"
 #include "vo/sparse/features.hpp"
@@ -55,6 +57,64 @@ struct SparseStereoOdometry::Impl {
   std::vector<CircleMatch> circles;
   std::vector<StereoPointMatch> points;
   std::vector<SparseMatchInfo> infos;
+  // lk_refinement: this pair's and the previous pair's images, and reused point buffers.
+  cv::Mat img_l1, img_r1, img_l0, img_r0;
+  std::vector<cv::Point2f> lk_from, lk_to;
+  std::vector<unsigned char> lk_status;
+  std::vector<float> lk_error;
+  std::vector<unsigned char> lk_keep;
+
+  // Tracks the current left patch of every circle into `target`, starting at (u, v) of each
+  // circle as `get` gives it; `set` stores the result. A circle whose track fails or moves
+  // farther than lk_max_shift_px is marked for removal.
+  template <class Get, class Set>
+  void lk_track(const cv::Mat& target, Get get, Set set) {
+    lk_to.clear();
+    for (const CircleMatch& c : circles) lk_to.push_back(get(c));
+    const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.005);
+    cv::calcOpticalFlowPyrLK(img_l1, target, lk_from, lk_to, lk_status, lk_error,
+                             cv::Size(options.lk_window_px, options.lk_window_px), 0, stop,
+                             cv::OPTFLOW_USE_INITIAL_FLOW);
+    for (std::size_t i = 0; i < circles.size(); ++i) {
+      const cv::Point2f start = get(circles[i]);
+      const cv::Point2f& end = lk_to[i];
+      if (lk_status[i] == 0 || !std::isfinite(end.x) || !std::isfinite(end.y) ||
+          std::hypot(end.x - start.x, end.y - start.y) > options.lk_max_shift_px) {
+        lk_keep[i] = 0;
+      } else {
+        set(circles[i], end);
+      }
+    }
+  }
+
+  // The final circles' positions by Lucas-Kanade (SparseVoOptions::lk_refinement). The right
+  // images are rectified, so only their columns are taken.
+  void lk_refine() {
+    lk_from.clear();
+    for (const CircleMatch& c : circles)
+      lk_from.emplace_back(static_cast<float>(c.u_lc), static_cast<float>(c.v_lc));
+    lk_keep.assign(circles.size(), 1);
+    lk_track(
+        img_r1, [](const CircleMatch& c) { return cv::Point2f(float(c.u_rc), float(c.v_lc)); },
+        [](CircleMatch& c, const cv::Point2f& p) { c.u_rc = p.x; });
+    lk_track(
+        img_l0, [](const CircleMatch& c) { return cv::Point2f(float(c.u_lp), float(c.v_lp)); },
+        [](CircleMatch& c, const cv::Point2f& p) {
+          c.u_lp = p.x;
+          c.v_lp = p.y;
+        });
+    lk_track(
+        img_r0, [](const CircleMatch& c) { return cv::Point2f(float(c.u_rp), float(c.v_lp)); },
+        [](CircleMatch& c, const cv::Point2f& p) { c.u_rp = p.x; });
+    const double dmin = options.min_disparity_px;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < circles.size(); ++i) {
+      const CircleMatch& c = circles[i];
+      if (lk_keep[i] == 0 || !(c.u_lc - c.u_rc >= dmin) || !(c.u_lp - c.u_rp >= dmin)) continue;
+      circles[kept++] = c;
+    }
+    circles.resize(kept);
+  }
 
   // The matches as Eq. (2) sees them: previous-frame points by Eq. (1), current observations.
   void to_points() {
@@ -115,6 +175,10 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
 
   s.detector.detect(frame.left, &s.l1);
   s.detector.detect(frame.right, &s.r1);
+  if (s.options.lk_refinement) {  // copies into buffers kept across frames: no allocation
+    frame.left.copyTo(s.img_l1);
+    frame.right.copyTo(s.img_r1);
+  }
   result.times.detect_ms = ms_since(t_start);
 
   // Whatever happens below, this pair is the next call's previous pair.
@@ -123,6 +187,8 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
     ~Advance() {
       std::swap(s.l0, s.l1);
       std::swap(s.r0, s.r1);
+      cv::swap(s.img_l0, s.img_l1);
+      cv::swap(s.img_r0, s.img_r1);
       s.has_previous = true;
     }
   } advance{s};
@@ -168,6 +234,7 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   }
   auto t = Clock::now();
   s.matcher.match(s.l1, s.r1, s.l0, s.r0, /*coarse_only=*/false, prior, &s.circles);
+  if (s.options.lk_refinement && !s.circles.empty()) s.lk_refine();
   match_ms += ms_since(t);
   t = Clock::now();
   s.to_points();

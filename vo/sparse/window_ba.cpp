@@ -130,7 +130,18 @@ WindowBundleAdjuster::Result WindowBundleAdjuster::add_frame(std::span<const Cir
       track.p = {p.x(), p.y(), p.z()};
       track.obs.push_back({prev.id, c.u_lp, c.v_lp, c.u_rp});
     }
-    tracks_[static_cast<std::size_t>(t)].obs.push_back({curr.id, c.u_lc, c.v_lc, c.u_rc});
+    // The new match follows the current left feature's own pixel, which lies a sub-pixel
+    // offset away from the track's point in the previous frame (its u_lp, v_lp, refined to
+    // sub-pixel, say where). Shift the new observation by that offset, the image motion being
+    // locally a translation, so that the track observes one scene point throughout.
+    Observation o{curr.id, c.u_lc, c.v_lc, c.u_rc};
+    const Observation& last = tracks_[static_cast<std::size_t>(t)].obs.back();
+    if (last.frame == prev.id) {
+      o.u_l += last.u_l - c.u_lp;
+      o.v_l += last.v_l - c.v_lp;
+      o.u_r += last.u_r - c.u_rp;
+    }
+    tracks_[static_cast<std::size_t>(t)].obs.push_back(o);
     slot_track_next_[static_cast<std::size_t>(c.slot_lc)] = t;
   }
   slot_track_prev_.swap(slot_track_next_);
