@@ -2,7 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <iterator>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.hpp"
@@ -13,6 +16,7 @@
 #include "eval/evaluate.hpp"
 #include "fusion/ca_smoother.hpp"
 #include "pipeline/render_stage.hpp"
+#include "pipeline/sensor_stage.hpp"
 #include "scenes/build_scene.hpp"
 #include "sim/render/renderer.hpp"
 #include "sim/waves/wave_field.hpp"
@@ -70,9 +74,26 @@ SE3 camera_mount_T_B_C(const sim::MountOptions& mount) {
   return SE3(R_B_C, Vec3(p[0], p[1], p[2]));
 }
 
+double motion_end_s(const Scenario& sc) {
+  double end_s = sc.mission.duration_s;
+  if (sc.pipeline.max_frames > 0) {
+    const double frames_s = (sc.pipeline.max_frames - 1) / sc.sensors.camera.rate_hz;
+    end_s = end_s > 0 ? std::min(end_s, frames_s) : frames_s;
+  }
+  return end_s > 0 ? end_s : sim::MotionOptions{}.hard_limit_s;
+}
+
 sim::MotionSummary simulate_scenario_motion(
     const Scenario& sc, const std::function<void(const sim::BodySample&)>& on_physics,
     const std::function<void(const sim::BodySample&)>& on_frame) {
+  return simulate_scenario_motion(sc, on_physics, on_frame, {}, nullptr);
+}
+
+sim::MotionSummary simulate_scenario_motion(
+    const Scenario& sc, const std::function<void(const sim::BodySample&)>& on_physics,
+    const std::function<void(const sim::BodySample&)>& on_frame,
+    const std::vector<TimeNs>& extra_times,
+    const std::function<void(const sim::BodySample&)>& on_extra) {
   // Waves and vessel from the scenario, the mission planned in the scene's geometry.
   const RngStreams rng(sc.seed);
   const auto waves = sim::make_wave_field(sc.water.waves, rng.stream("waves.phases"));
@@ -90,16 +111,31 @@ sim::MotionSummary simulate_scenario_motion(
   sim::MotionOptions motion;
   motion.physics_rate_hz = sc.vessel.physics_rate_hz;
   motion.max_duration_s = sc.mission.duration_s;
-  const double rate = sc.sensors.camera.rate_hz;
-  if (sc.pipeline.max_frames > 0) {
-    const double frames_s = (sc.pipeline.max_frames - 1) / rate;
-    motion.max_duration_s =
-        motion.max_duration_s > 0 ? std::min(motion.max_duration_s, frames_s) : frames_s;
-  }
-  const std::vector<TimeNs> frame_times = sim::sample_times(
-      rate, motion.max_duration_s > 0 ? motion.max_duration_s : motion.hard_limit_s);
+  const double end_s = motion_end_s(sc);
+  if (sc.pipeline.max_frames > 0 || sc.mission.duration_s > 0) motion.max_duration_s = end_s;
+  const std::vector<TimeNs> frame_times = sim::sample_times(sc.sensors.camera.rate_hz, end_s);
+  if (extra_times.empty() || !on_extra)
+    return sim::simulate(model, env, &guidance, sim::initial_state(model, start, heading), motion,
+                         frame_times, on_physics, on_frame);
+  // Camera frames and the other sensors' times in one sorted list; each time goes to whoever
+  // asked for it (both, when they coincide).
+  std::vector<TimeNs> all;
+  all.reserve(frame_times.size() + extra_times.size());
+  std::merge(frame_times.begin(), frame_times.end(), extra_times.begin(), extra_times.end(),
+             std::back_inserter(all));
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  std::size_t next_frame = 0, next_extra = 0;
   return sim::simulate(model, env, &guidance, sim::initial_state(model, start, heading), motion,
-                       frame_times, on_physics, on_frame);
+                       all, on_physics, [&](const sim::BodySample& b) {
+                         if (next_frame < frame_times.size() && frame_times[next_frame] == b.t_ns) {
+                           ++next_frame;
+                           on_frame(b);
+                         }
+                         if (next_extra < extra_times.size() && extra_times[next_extra] == b.t_ns) {
+                           ++next_extra;
+                           on_extra(b);
+                         }
+                       });
 }
 
 namespace {
@@ -130,18 +166,23 @@ std::unique_ptr<vo::StereoOdometry> make_vo(VoAlgorithm a, const StereoRig& rig,
 
 }  // namespace
 
-static void run_vision_stages(const Scenario& sc, const Trajectory& camera_gt,
-                       const std::vector<EulerZYX>& platform, const std::filesystem::path& dir,
-                       RunSummary* summary, nlohmann::json* metrics) {
-  const RngStreams rng(sc.seed);
-  const StereoRig rig = rig_of(sc.sensors.camera);
-  // Stage: render (the scene around the track, built once).
+// The scene around the camera track (river reach tiles covering its northings).
+static sim::SceneGeometry scene_for_track(const Scenario& sc, const Trajectory& camera_gt) {
   double north_min = camera_gt.front().T_W_C.translation().x(), north_max = north_min;
   for (const auto& p : camera_gt) {
     north_min = std::min(north_min, p.T_W_C.translation().x());
     north_max = std::max(north_max, p.T_W_C.translation().x());
   }
-  const sim::SceneGeometry scene = scenes::build_scene(sc.scene, sc.seed, north_min, north_max);
+  return scenes::build_scene(sc.scene, sc.seed, north_min, north_max);
+}
+
+static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scene,
+                              const Trajectory& camera_gt, const std::vector<EulerZYX>& platform,
+                              const std::filesystem::path& dir, RunSummary* summary,
+                              nlohmann::json* metrics) {
+  const RngStreams rng(sc.seed);
+  const StereoRig rig = rig_of(sc.sensors.camera);
+  // Stage: render (the scene built once, uploaded once).
   sim::StereoRenderer renderer(rig, sc.render);
   renderer.upload(scene);
   renderer.set_waves(sim::wave_components(sc.water.waves, rng.stream("waves.phases")));
@@ -289,12 +330,15 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
   AtomicFile body(dir.path() / "body_groundtruth.csv");
   body.write(body_csv_header());
   const auto t_physics = Clock::now();
+  SensorStage sensors(sc, dir.path());
   summary.motion = simulate_scenario_motion(
       sc, [&](const sim::BodySample& b) { body.write(body_csv_row(b)); },
       [&](const sim::BodySample& b) {
         camera_gt.push_back({b.t_ns, b.state.T_W_B() * T_B_C});
         platform.push_back(euler_zyx_from_quat(b.state.q_W_B));
-      });
+      },
+      sensors.sample_times(motion_end_s(sc)),
+      [&](const sim::BodySample& b) { sensors.on_sample(b); });
   summary.physics_s = seconds_since(t_physics);
   body.commit();
   write_tum(dir.path() / "groundtruth.tum", camera_gt);
@@ -304,8 +348,16 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
         (camera_gt[i].T_W_C.translation() - camera_gt[i - 1].T_W_C.translation()).norm();
 
   nlohmann::json metrics;
+  // Stage: sensors. GPS and compass need the scene (sky obstruction, steel structures).
+  const auto t_sensors = Clock::now();
+  std::optional<sim::SceneGeometry> scene;
+  if (!camera_gt.empty()) scene = scene_for_track(sc, camera_gt);
+  const SensorData sensor_data = sensors.finish(scene ? &*scene : nullptr);
+  metrics["sensors"] = sensor_data.stats;
+  metrics["timing"]["sensors_s"] = seconds_since(t_sensors);
+
   const bool run_vo = !options.only_motion && !sc.pipeline.vo.empty() && !camera_gt.empty();
-  if (run_vo) run_vision_stages(sc, camera_gt, platform, dir.path(), &summary, &metrics);
+  if (run_vo) run_vision_stages(sc, *scene, camera_gt, platform, dir.path(), &summary, &metrics);
 
   summary.total_s = seconds_since(t0);
   metrics["version"] = DRIFTLAB_VERSION;
@@ -319,7 +371,7 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
                        {"mean_speed_m_s", summary.motion.mean_speed_mps},
                        {"physics_steps", summary.motion.steps}};
   const char* vision = run_vo ? "done" : (options.only_motion ? "skipped (--only-motion)" : "skipped (no VO in pipeline.vo)");
-  metrics["stages"] = {{"scenario", "done"}, {"physics", "done"}, {"sensors", "unavailable"},
+  metrics["stages"] = {{"scenario", "done"}, {"physics", "done"}, {"sensors", "done"},
                        {"render", vision},     {"vo", vision},      {"fusion", vision},
                        {"eval", vision}};
   metrics["timing"]["physics_s"] = summary.physics_s;

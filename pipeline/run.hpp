@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "core/se3.hpp"
 #include "pipeline/scenario.hpp"
@@ -40,6 +41,18 @@ SE3 camera_mount_T_B_C(const sim::MountOptions& mount);
 sim::MotionSummary simulate_scenario_motion(
     const Scenario& scenario, const std::function<void(const sim::BodySample&)>& on_physics,
     const std::function<void(const sim::BodySample&)>& on_frame);
+
+/// The same, with `on_extra` called at every time of `extra_times` (sorted, unique), e.g. the
+/// other sensors' sample times, in time order interleaved with `on_frame`.
+sim::MotionSummary simulate_scenario_motion(
+    const Scenario& scenario, const std::function<void(const sim::BodySample&)>& on_physics,
+    const std::function<void(const sim::BodySample&)>& on_frame,
+    const std::vector<TimeNs>& extra_times,
+    const std::function<void(const sim::BodySample&)>& on_extra);
+
+/// How long the scenario's motion runs [s]: mission.duration_s, cut to pipeline.max_frames
+/// camera frames; without either, the simulator's hard limit (the mission ends it earlier).
+double motion_end_s(const Scenario& scenario);
 
 /// Runs `scenario` into `out_dir` (temporary folder renamed at the end).
 RunSummary run_scenario(const Scenario& scenario, const std::filesystem::path& out_dir,

@@ -431,6 +431,13 @@ struct CompassOptions {
   std::array<double, 3> hard_iron_nt{0.0, 0.0, 0.0};
   std::array<double, 9> soft_iron{1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
   std::vector<MagneticAnomalyOptions> anomalies;
+  // Ours: 2000 nT across the structure is ~6 deg of heading bias alongside it (horizontal field
+  // ~19500 nT at 66.5 deg dip), ~1.5 deg at 5 m: the order of the bias the river paper blames
+  // on steel sheet piling.
+  bool steel_structures = true;
+  std::array<double, 3> steel_field_ned_nt{2000.0, 2000.0, 0.0};
+  double steel_decay_length_m = 3.0;
+  double steel_decay_exponent = 2.0;
   ClockOptions clock;
 
   template <class A>
@@ -463,6 +470,16 @@ struct CompassOptions {
       yaml::in_range(-10, 10));
     a("anomalies", anomalies,
       "Local disturbances of steel structures (quay wall sheet piling, bridge)");
+    a("steel_structures", steel_structures,
+      "In a run, also attach an anomaly to each steel structure of the scene (quay wall sheet "
+      "piling, bridge), along the structure's length");
+    a("steel_field_ned_nt", steel_field_ned_nt,
+      "Field perturbation of those scene anomalies at the structure, world NED [nT]",
+      yaml::in_range(-1e6, 1e6));
+    a("steel_decay_length_m", steel_decay_length_m,
+      "Distance at which the scene anomalies have halved [m]", yaml::positive());
+    a("steel_decay_exponent", steel_decay_exponent, "Far-field fall-off of the scene anomalies",
+      yaml::in_range(0.5, 6));
     a("clock", clock, "Sample time stamps: offset, jitter, dropped samples");
     ClockOptions::require_ordered(a, clock, rate_hz);
   }

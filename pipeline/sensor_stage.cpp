@@ -1,0 +1,153 @@
+#include "pipeline/sensor_stage.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/rng.hpp"
+#include "scenes/sky_obstruction.hpp"
+
+namespace driftlab::pipeline {
+
+namespace {
+
+// Is t the next of `times` (advancing the cursor)?
+bool take(const std::vector<TimeNs>& times, std::size_t* next, TimeNs t) {
+  while (*next < times.size() && times[*next] < t) ++*next;
+  if (*next < times.size() && times[*next] == t) {
+    ++*next;
+    return true;
+  }
+  return false;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+struct SensorStage::Impl {
+  Scenario sc;
+  std::filesystem::path dir;
+  RngStreams rng;
+  std::unique_ptr<sim::ImuSimulator> imu;
+  std::unique_ptr<sim::ImuCsvWriter> imu_csv;
+  std::vector<TimeNs> imu_times, gps_times, compass_times;
+  std::size_t imu_next = 0, gps_next = 0, compass_next = 0;
+  std::vector<sim::BodySample> gps_bodies, compass_bodies;
+  SensorData data;
+
+  Impl(const Scenario& s, const std::filesystem::path& d) : sc(s), dir(d), rng(s.seed) {
+    if (sc.sensors.imu.enabled) {
+      imu = std::make_unique<sim::ImuSimulator>(sc.sensors.imu, rng, "imu");
+      imu_csv = std::make_unique<sim::ImuCsvWriter>(dir / "imu.csv");
+    }
+  }
+};
+
+SensorStage::SensorStage(const Scenario& sc, const std::filesystem::path& dir)
+    : impl_(std::make_unique<Impl>(sc, dir)) {}
+
+SensorStage::~SensorStage() = default;
+
+std::vector<TimeNs> SensorStage::sample_times(double end_s) const {
+  Impl& s = *impl_;
+  const auto& o = s.sc.sensors;
+  s.imu_times = o.imu.enabled ? sim::sample_times(o.imu.rate_hz, end_s) : std::vector<TimeNs>{};
+  s.gps_times = o.gps.enabled ? sim::sample_times(o.gps.rate_hz, end_s) : std::vector<TimeNs>{};
+  s.compass_times =
+      o.compass.enabled ? sim::sample_times(o.compass.rate_hz, end_s) : std::vector<TimeNs>{};
+  std::vector<TimeNs> all;
+  all.reserve(s.imu_times.size() + s.gps_times.size() + s.compass_times.size());
+  all.insert(all.end(), s.imu_times.begin(), s.imu_times.end());
+  all.insert(all.end(), s.gps_times.begin(), s.gps_times.end());
+  all.insert(all.end(), s.compass_times.begin(), s.compass_times.end());
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  return all;
+}
+
+void SensorStage::on_sample(const sim::BodySample& b) {
+  Impl& s = *impl_;
+  if (s.imu && take(s.imu_times, &s.imu_next, b.t_ns)) {
+    if (const auto m = s.imu->measure(b)) {
+      s.imu_csv->write(*m);
+      s.data.imu.push_back(*m);
+    }
+  }
+  if (take(s.gps_times, &s.gps_next, b.t_ns)) s.gps_bodies.push_back(b);
+  if (take(s.compass_times, &s.compass_next, b.t_ns)) s.compass_bodies.push_back(b);
+}
+
+SensorData SensorStage::finish(const sim::SceneGeometry* scene) {
+  Impl& s = *impl_;
+  nlohmann::json& stats = s.data.stats;
+  if (s.imu_csv) {
+    s.imu_csv->commit();
+    stats["imu"] = {{"samples", s.data.imu.size()}, {"rate_hz", s.sc.sensors.imu.rate_hz}};
+  }
+  if (s.sc.sensors.gps.enabled) {
+    std::unique_ptr<scenes::MeshSkyObstruction> sky;
+    if (scene != nullptr) sky = std::make_unique<scenes::MeshSkyObstruction>(*scene);
+    sim::GpsSimulator gps(s.sc.sensors.gps, s.rng, sky.get(), "gps");
+    sim::GpsCsvWriter csv(s.dir / "gps.csv");
+    std::vector<double> sats, hdop;
+    int below = 0, fixes = 0;
+    for (const sim::BodySample& b : s.gps_bodies) {
+      const auto fix = gps.measure(b);
+      if (!fix) continue;
+      csv.write(*fix);
+      s.data.gps.push_back(*fix);
+      sats.push_back(fix->satellites);
+      if (fix->satellites < s.sc.sensors.gps.min_satellites) ++below;
+      if (fix->fix) {
+        ++fixes;
+        hdop.push_back(fix->hdop);
+      }
+    }
+    csv.commit();
+    double hdop_mean = 0.0;
+    for (double h : hdop) hdop_mean += h / static_cast<double>(hdop.size());
+    const double n = static_cast<double>(s.data.gps.size());
+    stats["gps"] = {
+        {"epochs", s.data.gps.size()},
+        {"fix_fraction", n > 0 ? fixes / n : 0.0},
+        {"below_min_satellites_fraction", n > 0 ? below / n : 0.0},
+        {"median_satellites", sats.empty() ? 0.0 : median(sats)},
+        {"mean_hdop_with_fix", hdop.empty() ? nlohmann::json(nullptr) : nlohmann::json(hdop_mean)},
+        {"sky", scene != nullptr ? "scene meshes" : "open"}};
+  }
+  if (s.sc.sensors.compass.enabled) {
+    sim::CompassOptions options = s.sc.sensors.compass;
+    if (scene != nullptr && options.steel_structures) {
+      const auto steel =
+          scenes::steel_anomalies(*scene, options.steel_field_ned_nt, options.steel_decay_length_m,
+                                  options.steel_decay_exponent);
+      options.anomalies.insert(options.anomalies.end(), steel.begin(), steel.end());
+    }
+    sim::CompassSimulator compass(options, s.rng, "compass");
+    sim::CompassCsvWriter csv(s.dir / "compass.csv");
+    double sq = 0.0, worst = 0.0;
+    for (const sim::BodySample& b : s.compass_bodies) {
+      const auto m = compass.measure(b);
+      if (!m) continue;
+      csv.write(*m);
+      s.data.compass.push_back(*m);
+      const double e = std::remainder(m->heading_rad - m->true_heading_rad, 2 * M_PI);
+      sq += e * e;
+      worst = std::max(worst, std::abs(e));
+    }
+    csv.commit();
+    const double n = static_cast<double>(s.data.compass.size());
+    stats["compass"] = {{"samples", s.data.compass.size()},
+                        {"anomalies", options.anomalies.size()},
+                        {"heading_rmse_deg", n > 0 ? std::sqrt(sq / n) * 180 / M_PI : 0.0},
+                        {"heading_max_error_deg", worst * 180 / M_PI}};
+  }
+  return std::move(s.data);
+}
+
+}  // namespace driftlab::pipeline
