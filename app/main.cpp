@@ -6,6 +6,8 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <unistd.h>
+
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -68,6 +70,8 @@ int run_command(const std::string& file, const std::string& out_dir,
   driftlab::pipeline::RunOptions options;
   options.replace_existing = force;
   options.only_motion = only_motion;
+  options.progress = stderr;
+  options.progress_tty = isatty(STDERR_FILENO) != 0;
   const auto summary = driftlab::pipeline::run_scenario(scenario, out_dir, options);
   std::cout << summary.brief() << "\n";
   std::cerr << fmt::format("driftlab run: wrote {}\n", out_dir);

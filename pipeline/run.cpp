@@ -15,7 +15,9 @@
 #include "core/yaml_io.hpp"
 #include "eval/evaluate.hpp"
 #include "fusion/ca_smoother.hpp"
+#include "pipeline/progress.hpp"
 #include "pipeline/render_stage.hpp"
+#include "pipeline/report.hpp"
 #include "pipeline/sensor_stage.hpp"
 #include "scenes/build_scene.hpp"
 #include "sim/render/renderer.hpp"
@@ -24,6 +26,8 @@
 #include "vo/sparse/sparse_vo.hpp"
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #ifndef DRIFTLAB_VERSION
 #define DRIFTLAB_VERSION "unknown"
@@ -164,6 +168,24 @@ std::unique_ptr<vo::StereoOdometry> make_vo(VoAlgorithm a, const StereoRig& rig,
   return nullptr;
 }
 
+// Fig. 3 of the river paper: the current left image above the right one, each match's
+// points joined across the pair, its flow from the previous frame drawn in the left image.
+cv::Mat draw_matches(const vo::StereoFrame& frame, std::span<const vo::SparseMatchInfo> matches) {
+  cv::Mat gray, out;
+  cv::vconcat(frame.left, frame.right, gray);
+  cv::cvtColor(gray, out, cv::COLOR_GRAY2BGR);
+  const int h = frame.left.rows;
+  for (const auto& m : matches) {
+    const cv::Scalar colour = m.inlier ? cv::Scalar(0, 200, 0) : cv::Scalar(0, 0, 255);
+    const cv::Point2d l(m.u_lc, m.v_lc), r(m.u_rc, m.v_lc + h), prev(m.u_lp, m.v_lp);
+    cv::line(out, l, r, colour * 0.5, 1, cv::LINE_AA);
+    cv::line(out, l, prev, cv::Scalar(0, 160, 255), 1, cv::LINE_AA);
+    cv::circle(out, l, 3, colour, 1, cv::LINE_AA);
+    cv::circle(out, r, 3, colour, 1, cv::LINE_AA);
+  }
+  return out;
+}
+
 }  // namespace
 
 // The scene around the camera track (river reach tiles covering its northings).
@@ -178,8 +200,8 @@ static sim::SceneGeometry scene_for_track(const Scenario& sc, const Trajectory& 
 
 static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scene,
                               const Trajectory& camera_gt, const std::vector<EulerZYX>& platform,
-                              const std::filesystem::path& dir, RunSummary* summary,
-                              nlohmann::json* metrics) {
+                              const std::filesystem::path& dir, const RunOptions& options,
+                              RunSummary* summary, nlohmann::json* metrics) {
   const RngStreams rng(sc.seed);
   const StereoRig rig = rig_of(sc.sensors.camera);
   // Stage: render (the scene built once, uploaded once).
@@ -227,7 +249,11 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
     header += fmt::format(",{0}_valid,{0}_inliers,{0}_mean_depth_m,{0}_ms", tracks[i].name);
   frames_csv.write(header + "\n");
   double render_s = 0;
+  Progress progress(options.progress, "render+vo", camera_gt.size(), options.progress_tty);
+  const std::size_t sample_frame = camera_gt.size() / 2;  // drawn with its matches (Fig. 3)
+  std::filesystem::create_directories(dir / "plots");
   for (std::size_t k = 0; k < camera_gt.size(); ++k) {
+    progress.update(k);
     const TimeNs t = camera_gt[k].t_ns;
     const auto t_render = std::chrono::steady_clock::now();
     const sim::StereoImages img = renderer.render(camera_gt[k].T_W_C, ns_to_seconds(t), false);
@@ -247,6 +273,11 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
       Track& tr = tracks[i];
       const vo::VoResult r =
           tr.vo ? tr.vo->process(frame) : tracks[tr.source].results.back();
+      if (k == sample_frame && tr.vo && r.valid) {
+        if (const auto* sparse = dynamic_cast<const vo::SparseStereoOdometry*>(tr.vo.get()))
+          cv::imwrite((dir / "plots" / (tr.name + "_matches.png")).string(),
+                      draw_matches(frame, sparse->last_matches()));
+      }
       if (tr.vo) {
         tr.results.push_back(r);
         tr.vo_ms += r.times.total_ms;
@@ -264,6 +295,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
     }
     frames_csv.write(row + "\n");
   }
+  progress.update(camera_gt.size());
+  progress.finish();
   frames_csv.commit();
   std::filesystem::create_directories(dir / "estimates");
   for (const auto& tr : tracks) write_tum(dir / "estimates" / (tr.name + ".tum"), tr.estimate);
@@ -305,7 +338,25 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
           tr.vo_ms / static_cast<double>(camera_gt.size());
   }
   write_file_atomic(dir / "sections.csv", sections);
+
+  // Report: plots (gnuplot) and the same report as HTML.
+  std::vector<NamedTrajectory> named;
+  for (const auto& tr : tracks) named.push_back({tr.name, tr.estimate});
+  std::string plot_warning;
+  std::vector<PlotFile> plots = make_plots(dir, camera_gt, named, sections, &plot_warning);
+  if (!plot_warning.empty()) warnings.push_back(plot_warning);
+  for (const auto& tr : tracks)
+    if (std::filesystem::exists(dir / "plots" / (tr.name + "_matches.png")))
+      plots.push_back({fmt::format("Stereo pair at frame {} with the {} matches: current left "
+                                   "(top) and right (bottom), inliers green, outliers red, flow "
+                                   "from the previous frame in orange (Fig. 3)",
+                                   sample_frame, tr.name),
+                       "plots/" + tr.name + "_matches.png"});
+  const std::string tables = report;
+  if (!plots.empty()) report += "## Plots\n\n";
+  for (const auto& p : plots) report += fmt::format("![{}]({})\n\n", p.title, p.file);
   write_file_atomic(dir / "report.md", report);
+  write_file_atomic(dir / "report.html", report_html("driftlab run: " + sc.name, tables, plots));
   (*metrics)["timing"]["render_s"] = render_s;
   (*metrics)["timing"]["render_pairs_per_s"] =
       render_s > 0 ? static_cast<double>(camera_gt.size()) / render_s : 0.0;
@@ -357,7 +408,8 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
   metrics["timing"]["sensors_s"] = seconds_since(t_sensors);
 
   const bool run_vo = !options.only_motion && !sc.pipeline.vo.empty() && !camera_gt.empty();
-  if (run_vo) run_vision_stages(sc, *scene, camera_gt, platform, dir.path(), &summary, &metrics);
+  if (run_vo)
+    run_vision_stages(sc, *scene, camera_gt, platform, dir.path(), options, &summary, &metrics);
 
   summary.total_s = seconds_since(t0);
   metrics["version"] = DRIFTLAB_VERSION;

@@ -4,6 +4,7 @@
 // and evaluation with their issues.
 #pragma once
 
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -18,6 +19,8 @@ namespace driftlab::pipeline {
 struct RunOptions {
   bool replace_existing = false;
   bool only_motion = false;  // stop after the physics stage
+  std::FILE* progress = nullptr;  // progress of the frame loop (e.g. stderr); null: none
+  bool progress_tty = false;      // redraw a bar in place (a terminal) instead of plain lines
 };
 
 struct RunSummary {

@@ -183,6 +183,34 @@ TEST(Cli, RunWritesAtomicallyAndRefusesToOverwrite) {
   fs::remove_all(dir);
 }
 
+// DESIGN.md: an interrupted run leaves nothing that looks complete. Kill a run in its frame
+// loop (SIGKILL: no handler can tidy up) and look at what is left.
+TEST(Cli, KilledRunLeavesNoOutputFolder) {
+  const fs::path dir = fresh_temp_dir("killed");
+  const fs::path out = dir / "out";
+  const fs::path log = dir / "log";
+  const std::string cmd = quote(kCli.string()) + " run " +
+                          quote((kSource / "scenarios/river_crossing.yaml").string()) +
+                          " --out " + quote(out.string()) + " > " + quote(log.string()) +
+                          " 2>&1 & pid=$!; " +
+                          // wait until the frame loop reports progress, then kill
+                          "for i in $(seq 1 600); do grep -q frames " + quote(log.string()) +
+                          " && break; sleep 0.1; done; kill -9 $pid; wait $pid";
+  const int status = std::system(("bash -c " + quote(cmd)).c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 128 + 9) << read_text(log);  // it was still running
+  EXPECT_NE(read_text(log).find("frames"), std::string::npos);
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    EXPECT_TRUE(name == "log" || name.rfind("out.tmp.", 0) == 0) << "unexpected: " << name;
+    if (e.is_directory()) {
+      EXPECT_FALSE(fs::exists(e.path() / "metrics.json")) << name;
+    }
+  }
+  fs::remove_all(dir);
+}
+
 TEST(Cli, HelpForEverySubcommand) {
   for (const auto& sub : {"scenario", "run", "render", "eval", "sweep", "regress"}) {
     const Result r = run_cli({sub, "--help"});

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -81,7 +83,9 @@ TEST(Run, SameSeedSameBytes) {
   run_scenario(sc, a, {});
   run_scenario(sc, b, {});
   for (const char* f : {"groundtruth.tum", "body_groundtruth.csv", "scenario.resolved.yaml",
-                        "estimates/sparse.tum", "estimates/sparse_ca.tum", "sections.csv"})
+                        "estimates/sparse.tum", "estimates/sparse_ca.tum", "sections.csv",
+                        "imu.csv", "gps.csv", "compass.csv", "plots/data/sparse.dat",
+                        "plots/plots.gp"})
     EXPECT_EQ(slurp(a / f), slurp(b / f)) << f;
   // metrics.json too, apart from the wall-clock figures under "timing".
   auto metrics = [](const fs::path& d) {
@@ -94,6 +98,37 @@ TEST(Run, SameSeedSameBytes) {
   EXPECT_TRUE(fs::exists(a / "frames.csv"));
   fs::remove_all(a);
   fs::remove_all(b);
+}
+
+TEST(Run, SensorsSampleAtTheirRatesFromTheSameGroundTruth) {
+  const fs::path out = temp_dir("sensors");
+  Scenario sc = short_crossing(27);  // 2 s at 13 Hz
+  sc.sensors.imu.preset = sim::ImuPreset::kIdeal;
+  sc.sensors.imu.apply_preset(sim::ImuPreset::kIdeal);
+  run_scenario(sc, out, {.only_motion = true});
+  auto rows = [&](const char* f) {
+    const std::string s = slurp(out / f);
+    return std::count(s.begin(), s.end(), '\n') - 1;  // without the header
+  };
+  EXPECT_EQ(rows("imu.csv"), 401);     // 2 s at 200 Hz, t = 0 included
+  EXPECT_EQ(rows("gps.csv"), 3);       // 1 Hz
+  EXPECT_EQ(rows("compass.csv"), 21);  // 10 Hz
+  // An ideal IMU on a vessel floating at rest reads gravity: -g along body z, no rotation.
+  const std::string imu = slurp(out / "imu.csv");
+  const std::string first = imu.substr(imu.find('\n') + 1, imu.find('\n', imu.find('\n') + 1));
+  double t, wx, wy, wz, ax, ay, az;
+  ASSERT_EQ(std::sscanf(first.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &t, &wx, &wy, &wz, &ax, &ay,
+                        &az),
+            7);
+  EXPECT_NEAR(az, -9.80665, 0.05);
+  EXPECT_NEAR(std::hypot(wx, wy, wz), 0.0, 1e-3);
+  const auto metrics = nlohmann::json::parse(slurp(out / "metrics.json"));
+  EXPECT_EQ(metrics["sensors"]["imu"]["samples"], 401);
+  EXPECT_EQ(metrics["sensors"]["gps"]["sky"], "scene meshes");
+  EXPECT_EQ(metrics["stages"]["sensors"], "done");
+  // The river scene has a bridge and a quay wall: their steel disturbs the compass.
+  EXPECT_GE(metrics["sensors"]["compass"]["anomalies"].get<int>(), 2);
+  fs::remove_all(out);
 }
 
 TEST(Run, WholeDischargeMeasurementMission) {

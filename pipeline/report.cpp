@@ -1,0 +1,296 @@
+#include "pipeline/report.hpp"
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "core/atomic_file.hpp"
+#include "core/rotation.hpp"
+#include "core/time.hpp"
+#include "core/yaml_io.hpp"
+
+namespace driftlab::pipeline {
+
+namespace {
+
+std::string num(double v) { return std::isfinite(v) ? yaml::format_double(v) : "NaN"; }
+
+// Euler ZYX [deg] of the camera with FRD axes (x along the optical axis): the attitude a
+// reader compares with the platform's (river paper Fig. 7).
+Vec3 camera_euler_deg(const SE3& T_W_C) {
+  const EulerZYX e = euler_zyx_from_matrix(T_W_C.rotation() * R_frd_optical().transpose());
+  return Vec3(rad2deg(e.yaw_rad), rad2deg(e.pitch_rad), rad2deg(e.roll_rad));
+}
+
+std::string trajectory_dat(const Trajectory& tr, const Trajectory* gt) {
+  std::string s = "# t_s north_m east_m down_m yaw_deg pitch_deg roll_deg err3d_m\n";
+  for (std::size_t k = 0; k < tr.size(); ++k) {
+    const Vec3 p = tr[k].T_W_C.translation();
+    const Vec3 e = camera_euler_deg(tr[k].T_W_C);
+    double err = NAN;
+    if (gt != nullptr && k < gt->size() && (*gt)[k].t_ns == tr[k].t_ns)
+      err = (p - (*gt)[k].T_W_C.translation()).norm();
+    s += fmt::format("{} {} {} {} {} {} {} {}\n", num(ns_to_seconds(tr[k].t_ns)), num(p.x()),
+                     num(p.y()), num(p.z()), num(e.x()), num(e.y()), num(e.z()), num(err));
+  }
+  return s;
+}
+
+std::vector<std::string> split(const std::string& line, char sep) {
+  std::vector<std::string> out;
+  std::string cell;
+  std::istringstream in(line);
+  while (std::getline(in, cell, sep)) out.push_back(cell);
+  if (!line.empty() && line.back() == sep) out.emplace_back();
+  return out;
+}
+
+// gnuplot string literal (single quotes; a quote is doubled).
+std::string q(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string html_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+int run_program(const std::vector<std::string>& argv, const std::filesystem::path& cwd,
+                const std::filesystem::path& log) {
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    if (chdir(cwd.c_str()) != 0) _exit(127);
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      dup2(fd, 1);
+      dup2(fd, 2);
+      close(fd);
+    }
+    execvp(args[0], args.data());
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return -1;
+  }
+  if (!WIFEXITED(status)) return -1;
+  return WEXITSTATUS(status) == 127 ? -1 : WEXITSTATUS(status);
+}
+
+std::vector<PlotFile> make_plots(const std::filesystem::path& dir, const Trajectory& gt,
+                                 const std::vector<NamedTrajectory>& estimates,
+                                 const std::string& sections_csv, std::string* warning) {
+  const std::filesystem::path plots = dir / "plots";
+  std::filesystem::create_directories(plots / "data");
+  write_file_atomic(plots / "data" / "groundtruth.dat", trajectory_dat(gt, nullptr));
+  for (const auto& e : estimates)
+    write_file_atomic(plots / "data" / (e.name + ".dat"), trajectory_dat(e.trajectory, &gt));
+
+  // sections.csv split per algorithm: p_m_per_m and the covariates.
+  std::map<std::string, std::string> section_rows;
+  std::vector<std::string> section_order;
+  std::istringstream in(sections_csv);
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = split(line, ',');
+  auto column = [&header](const std::string& name) {
+    for (std::size_t i = 0; i < header.size(); ++i)
+      if (header[i] == name) return static_cast<int>(i);
+    return -1;
+  };
+  const std::vector<std::string> cov_names = {"v", "h", "f", "d"};
+  const int c_alg = column("algorithm"), c_p = column("p_m_per_m");
+  while (std::getline(in, line)) {
+    const auto cells = split(line, ',');
+    if (c_alg < 0 || c_p < 0 || cells.size() != header.size()) continue;
+    const std::string& alg = cells[static_cast<std::size_t>(c_alg)];
+    if (!section_rows.count(alg)) section_order.push_back(alg);
+    std::string row = cells[static_cast<std::size_t>(c_p)];
+    for (const auto& c : cov_names) {
+      const int i = column(c);
+      row += " " + (i >= 0 && !cells[static_cast<std::size_t>(i)].empty()
+                        ? cells[static_cast<std::size_t>(i)]
+                        : std::string("NaN"));
+    }
+    section_rows[alg] += row + "\n";
+  }
+  for (const auto& alg : section_order)
+    write_file_atomic(plots / "data" / ("sections_" + alg + ".dat"),
+                      "# p_m_per_m v h f d\n" + section_rows[alg]);
+
+  std::vector<PlotFile> made;
+  std::string gp =
+      "# Made by driftlab run; re-run with: cd plots && gnuplot plots.gp\n"
+      "set terminal pngcairo size 900,640 font ',10' noenhanced\n"
+      "set grid\nset key outside right top\n";
+  auto curves = [&](const std::string& using_gt, const std::string& using_est, bool with_gt) {
+    std::string s;
+    if (with_gt) s += "'data/groundtruth.dat' using " + using_gt + " with lines lw 2 lc 'black' title 'ground truth'";
+    for (const auto& e : estimates) {
+      if (!s.empty()) s += ", ";
+      s += q("data/" + e.name + ".dat") + " using " + using_est + " with lines title " + q(e.name);
+    }
+    return s;
+  };
+  gp += "set output 'top_view.png'\nset title 'Top view (river paper Fig. 6)'\n"
+        "set xlabel 'east [m]'\nset ylabel 'north [m]'\nset size ratio -1\n"
+        "plot " + curves("3:2", "3:2", true) + "\nset size noratio\n";
+  made.push_back({"Top view of the ground truth and every estimate (Fig. 6)", "plots/top_view.png"});
+  gp += "set output 'position_error.png'\nset title '3D position error'\n"
+        "set xlabel 'time [s]'\nset ylabel 'error [m]'\nplot " + curves("1:8", "1:8", false) + "\n";
+  made.push_back({"3D position error over time", "plots/position_error.png"});
+  gp += "set output 'euler.png'\nset multiplot layout 3,1 title 'Camera attitude, FRD axes (Fig. 7)'\n"
+        "set xlabel ''\n";
+  const char* angles[] = {"yaw", "pitch", "roll"};
+  for (int a = 0; a < 3; ++a) {
+    const std::string col = std::to_string(5 + a);
+    gp += fmt::format("set title ''\nset ylabel '{} [deg]'\n{}plot {}\n", angles[a],
+                      a == 2 ? "set xlabel 'time [s]'\n" : "",
+                      curves("1:" + col, "1:" + col, true));
+  }
+  gp += "unset multiplot\n";
+  made.push_back({"Euler angles of the estimates and the truth (Fig. 7)", "plots/euler.png"});
+  if (!section_order.empty()) {
+    gp += "set output 'section_errors.png'\nset title 'Section position error e''_p (Fig. 5)'\n"
+          "set xlabel 'e''_p [m/m]'\nset ylabel 'sections'\nset style fill transparent solid 0.4\n"
+          "bin(x) = 0.02 * floor(x / 0.02) + 0.01\nplot ";
+    for (std::size_t i = 0; i < section_order.size(); ++i)
+      gp += (i ? ", " : "") + q("data/sections_" + section_order[i] + ".dat") +
+            " using (bin($1)):(1) smooth frequency with boxes title " + q(section_order[i]);
+    gp += "\nset style fill empty\n";
+    made.push_back({"Distribution of the section errors (Fig. 5)", "plots/section_errors.png"});
+    const std::string first = section_order.front();
+    gp += "set output 'covariates.png'\nset multiplot layout 2,2 title " +
+          q("Section error against the covariates, " + first + " (Table 3)") + "\n";
+    const char* labels[] = {"v: speed [m/s]", "h: yaw rate sd [deg/s]", "f: inlier features",
+                            "d: mean feature depth [m]"};
+    // The least-squares line of each panel (simple regression of e'_p on one covariate).
+    std::vector<std::array<double, 2>> xy[4];
+    {
+      std::istringstream rows(section_rows[first]);
+      std::string r;
+      while (std::getline(rows, r)) {
+        std::istringstream v(r);
+        double p = NAN, c[4] = {NAN, NAN, NAN, NAN};
+        v >> p >> c[0] >> c[1] >> c[2] >> c[3];
+        for (int k = 0; k < 4; ++k)
+          if (std::isfinite(p) && std::isfinite(c[k])) xy[k].push_back({c[k], p});
+      }
+    }
+    for (int c = 0; c < 4; ++c) {
+      const std::string data = q("data/sections_" + first + ".dat");
+      gp += fmt::format("set title ''\nset xlabel '{}'\nset ylabel 'e''_p [m/m]'\n", labels[c]);
+      gp += fmt::format("plot {} using {}:1 with points pt 7 ps 0.6 title 'sections'", data, c + 2);
+      const auto& pts = xy[c];
+      double mx = 0, my = 0;
+      for (const auto& p : pts) {
+        mx += p[0] / static_cast<double>(pts.size());
+        my += p[1] / static_cast<double>(pts.size());
+      }
+      double sxx = 0, sxy = 0;
+      for (const auto& p : pts) {
+        sxx += (p[0] - mx) * (p[0] - mx);
+        sxy += (p[0] - mx) * (p[1] - my);
+      }
+      if (pts.size() >= 3 && sxx > 1e-12 * (1 + mx * mx) * static_cast<double>(pts.size())) {
+        const double b = sxy / sxx, a = my - b * mx;
+        gp += fmt::format(", {} + {} * x with lines lw 2 title 'least squares'", num(a), num(b));
+      }
+      gp += "\n";
+    }
+    gp += "unset multiplot\n";
+    made.push_back({"Section error against each covariate, with a least-squares line",
+                    "plots/covariates.png"});
+  }
+  write_file_atomic(plots / "plots.gp", gp);
+  const int rc = run_program({"gnuplot", "plots.gp"}, plots, plots / "gnuplot.log");
+  if (rc != 0) {
+    *warning = rc < 0 ? "gnuplot not found: no plots (install gnuplot-nox)"
+                      : fmt::format("gnuplot failed (exit {}): see plots/gnuplot.log", rc);
+    return {};
+  }
+  std::filesystem::remove(plots / "gnuplot.log");
+  return made;
+}
+
+std::string report_html(const std::string& title, const std::string& markdown,
+                        const std::vector<PlotFile>& plots) {
+  std::string h = "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>" +
+                  html_escape(title) +
+                  "</title>\n<style>body{font-family:sans-serif;max-width:70em;margin:auto}"
+                  "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #999;"
+                  "padding:2px 8px;text-align:right}th{background:#eee}img{max-width:100%}"
+                  "</style></head><body>\n";
+  std::istringstream in(markdown);
+  std::string line;
+  bool in_table = false, header_row = false;
+  auto cells = [](const std::string& l) {
+    std::vector<std::string> out;
+    std::string t = l.substr(1, l.size() > 1 && l.back() == '|' ? l.size() - 2 : l.size() - 1);
+    for (auto& c : split(t, '|')) {
+      const auto b = c.find_first_not_of(' '), e = c.find_last_not_of(' ');
+      out.push_back(b == std::string::npos ? "" : c.substr(b, e - b + 1));
+    }
+    return out;
+  };
+  while (std::getline(in, line)) {
+    const bool table_line = !line.empty() && line[0] == '|';
+    if (table_line && !in_table) {
+      h += "<table>\n";
+      in_table = header_row = true;
+    } else if (!table_line && in_table) {
+      h += "</table>\n";
+      in_table = false;
+    }
+    if (table_line) {
+      if (line.find("---") != std::string::npos && line.find_first_not_of("|-: ") == std::string::npos)
+        continue;  // the separator row
+      const char* tag = header_row ? "th" : "td";
+      h += "<tr>";
+      for (const auto& c : cells(line)) h += fmt::format("<{0}>{1}</{0}>", tag, html_escape(c));
+      h += "</tr>\n";
+      header_row = false;
+    } else if (line.rfind("### ", 0) == 0) {
+      h += "<h3>" + html_escape(line.substr(4)) + "</h3>\n";
+    } else if (line.rfind("## ", 0) == 0) {
+      h += "<h2>" + html_escape(line.substr(3)) + "</h2>\n";
+    } else if (line.rfind("# ", 0) == 0) {
+      h += "<h1>" + html_escape(line.substr(2)) + "</h1>\n";
+    } else if (!line.empty()) {
+      h += "<p>" + html_escape(line) + "</p>\n";
+    }
+  }
+  if (in_table) h += "</table>\n";
+  if (!plots.empty()) h += "<h2>Plots</h2>\n";
+  for (const auto& p : plots)
+    h += fmt::format("<figure><img src=\"{0}\" alt=\"{1}\"><figcaption>{1}</figcaption></figure>\n",
+                     html_escape(p.file), html_escape(p.title));
+  return h + "</body></html>\n";
+}
+
+}  // namespace driftlab::pipeline
