@@ -155,13 +155,13 @@ struct Track {
   double vo_ms = 0;
 };
 
-std::unique_ptr<vo::StereoOdometry> make_vo(VoAlgorithm a, const StereoRig& rig, const RngStreams& rng) {
+std::unique_ptr<vo::StereoOdometry> make_vo(VoAlgorithm a, const StereoRig& rig,
+                                            const PipelineOptions& p, const RngStreams& rng) {
   switch (a) {
     case VoAlgorithm::kSparse:
-      return std::make_unique<vo::SparseStereoOdometry>(rig, vo::SparseVoOptions{},
-                                                        rng.stream("vo.sparse"));
+      return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse, rng.stream("vo.sparse"));
     case VoAlgorithm::kPnp:
-      return std::make_unique<vo::PnpStereoOdometry>(rig, vo::PnpVoOptions{}, rng.stream("vo.pnp"));
+      return std::make_unique<vo::PnpStereoOdometry>(rig, p.pnp, rng.stream("vo.pnp"));
     case VoAlgorithm::kDense:
       return nullptr;  // lands with the dense VO issue
   }
@@ -214,7 +214,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   std::vector<Track> tracks;
   std::vector<std::string> warnings;
   for (VoAlgorithm a : sc.pipeline.vo) {
-    auto v = make_vo(a, rig, rng);
+    auto v = make_vo(a, rig, sc.pipeline, rng);
     if (!v) {
       warnings.push_back(fmt::format("pipeline.vo: '{}' is not in this build yet; skipped",
                                      yaml::enum_name(a)));
@@ -235,8 +235,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
     for (std::size_t i = 0; i < n_vo; ++i) {
       Track t;
       t.name = tracks[i].name + "_ca";
-      t.smoother = std::make_unique<fusion::ConstantAccelerationSmoother>(
-          fusion::ConstantAccelerationSmoother::Options{});
+      t.smoother =
+          std::make_unique<fusion::ConstantAccelerationSmoother>(sc.pipeline.ca_smoother);
       t.source = i;
       tracks.push_back(std::move(t));
     }

@@ -9,11 +9,14 @@
 
 #include "core/yaml_io.hpp"
 #include "eval/eval_options.hpp"
+#include "fusion/ca_smoother.hpp"
 #include "scenes/scene_options.hpp"
 #include "sim/render/render_options.hpp"
 #include "sim/sensors/sensor_options.hpp"
 #include "sim/vessel/vessel_options.hpp"
 #include "sim/waves/wave_options.hpp"
+#include "vo/pnp/pnp_options.hpp"
+#include "vo/sparse/sparse_options.hpp"
 
 namespace driftlab::pipeline {
 
@@ -36,6 +39,10 @@ struct PipelineOptions {
   std::vector<VoAlgorithm> vo{VoAlgorithm::kSparse};
   std::vector<FusionAlgorithm> fusion{FusionAlgorithm::kCaSmoother};
   int max_frames = 0;
+  // Options of each algorithm (used when it runs).
+  vo::SparseVoOptions sparse;
+  vo::PnpVoOptions pnp;
+  fusion::CaSmootherOptions ca_smoother;
 
   template <class A>
   void visit(A& a) {
@@ -43,6 +50,10 @@ struct PipelineOptions {
     a("fusion", fusion, "Filters and smoothers to run on the VO output");
     a("max_frames", max_frames, "Stop after this many stereo frames (0 = whole mission)",
       yaml::non_negative());
+    a("sparse", sparse, "Options of the sparse VO (river paper Section 2.3.1)");
+    a("pnp", pnp, "Options of the GFTT+PnP VO (basin paper Section 3.1)");
+    a("ca_smoother", ca_smoother,
+      "Options of the constant-acceleration smoother (river paper Eqs. (4)-(5))");
   }
 };
 
