@@ -15,6 +15,7 @@
 #include "core/yaml_io.hpp"
 #include "eval/evaluate.hpp"
 #include "fusion/ca_smoother.hpp"
+#include "pipeline/filter_stage.hpp"
 #include "pipeline/progress.hpp"
 #include "pipeline/render_stage.hpp"
 #include "pipeline/report.hpp"
@@ -22,6 +23,7 @@
 #include "scenes/build_scene.hpp"
 #include "sim/render/renderer.hpp"
 #include "sim/waves/wave_field.hpp"
+#include "vo/dense/dense_vo.hpp"
 #include "vo/pnp/pnp_vo.hpp"
 #include "vo/sparse/sparse_vo.hpp"
 
@@ -149,6 +151,7 @@ struct Track {
   std::string name;
   std::unique_ptr<vo::StereoOdometry> vo;
   std::unique_ptr<fusion::ConstantAccelerationSmoother> smoother;  // set for NAME_ca streams
+  std::unique_ptr<FilterTrack> filter;  // NAME_ned_kf, NAME_ned_pf, NAME_eskf streams
   std::size_t source = 0;  // for a smoothed stream: the VO track it follows
   Trajectory estimate;
   std::vector<vo::VoResult> results;
@@ -163,7 +166,7 @@ std::unique_ptr<vo::StereoOdometry> make_vo(VoAlgorithm a, const StereoRig& rig,
     case VoAlgorithm::kPnp:
       return std::make_unique<vo::PnpStereoOdometry>(rig, p.pnp, rng.stream("vo.pnp"));
     case VoAlgorithm::kDense:
-      return nullptr;  // lands with the dense VO issue
+      return std::make_unique<vo::DenseStereoOdometry>(rig, p.dense, rng.stream("vo.dense"));
   }
   return nullptr;
 }
@@ -199,7 +202,8 @@ static sim::SceneGeometry scene_for_track(const Scenario& sc, const Trajectory& 
 }
 
 static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scene,
-                              const Trajectory& camera_gt, const std::vector<EulerZYX>& platform,
+                              const SensorData& sensor_data, const Trajectory& camera_gt,
+                              const std::vector<EulerZYX>& platform,
                               const std::filesystem::path& dir, const RunOptions& options,
                               RunSummary* summary, nlohmann::json* metrics) {
   const RngStreams rng(sc.seed);
@@ -226,18 +230,20 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
     tracks.push_back(std::move(t));
   }
   const std::size_t n_vo = tracks.size();
+  const SE3 T_W_B0 =
+      camera_gt.front().T_W_C * camera_mount_T_B_C(sc.sensors.camera.mount).inverse();
   for (FusionAlgorithm f : sc.pipeline.fusion) {
-    if (f != FusionAlgorithm::kCaSmoother) {
-      warnings.push_back(fmt::format("pipeline.fusion: '{}' is not in this build yet; skipped",
-                                     yaml::enum_name(f)));
-      continue;
-    }
     for (std::size_t i = 0; i < n_vo; ++i) {
       Track t;
-      t.name = tracks[i].name + "_ca";
-      t.smoother =
-          std::make_unique<fusion::ConstantAccelerationSmoother>(sc.pipeline.ca_smoother);
       t.source = i;
+      if (f == FusionAlgorithm::kCaSmoother) {
+        t.name = tracks[i].name + "_ca";
+        t.smoother =
+            std::make_unique<fusion::ConstantAccelerationSmoother>(sc.pipeline.ca_smoother);
+      } else {
+        t.name = tracks[i].name + "_" + std::string(yaml::enum_name(f));
+        t.filter = std::make_unique<FilterTrack>(f, sc, sensor_data, T_W_B0, rng);
+      }
       tracks.push_back(std::move(t));
     }
   }
@@ -246,7 +252,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   AtomicFile frames_csv(dir / "frames.csv");
   std::string header = "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms";
   for (std::size_t i = 0; i < n_vo; ++i)
-    header += fmt::format(",{0}_valid,{0}_inliers,{0}_mean_depth_m,{0}_ms", tracks[i].name);
+    header += fmt::format(",{0}_valid,{0}_inliers,{0}_valid_depth_px,{0}_mean_depth_m,{0}_ms",
+                          tracks[i].name);
   frames_csv.write(header + "\n");
   double render_s = 0;
   Progress progress(options.progress, "render+vo", camera_gt.size(), options.progress_tty);
@@ -281,12 +288,17 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
       if (tr.vo) {
         tr.results.push_back(r);
         tr.vo_ms += r.times.total_ms;
-        row += fmt::format(",{},{},{},{:.3f}", r.valid ? 1 : 0, r.inliers,
+        row += fmt::format(",{},{},{},{},{:.3f}", r.valid ? 1 : 0, r.inliers, r.valid_depth_pixels,
                            r.valid ? yaml::format_double(r.mean_inlier_depth_m) : "",
                            r.times.total_ms);
       }
       if (k == 0) {
         if (tr.smoother) tr.smoother->update(t, r);  // starts the clock
+        if (tr.filter) tr.filter->step(t, r);         // starts from the anchor
+        continue;
+      }
+      if (tr.filter) {  // absolute poses, not increments
+        tr.estimate.push_back({t, tr.filter->step(t, r)});
         continue;
       }
       SE3 step = r.valid ? r.T_prev_curr : SE3();
@@ -299,7 +311,11 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   progress.finish();
   frames_csv.commit();
   std::filesystem::create_directories(dir / "estimates");
-  for (const auto& tr : tracks) write_tum(dir / "estimates" / (tr.name + ".tum"), tr.estimate);
+  for (const auto& tr : tracks) {
+    write_tum(dir / "estimates" / (tr.name + ".tum"), tr.estimate);
+    if (tr.filter && tr.filter->writes_states())
+      tr.filter->write_states(dir / "estimates" / (tr.name + ".csv"));
+  }
 
   // Stage: evaluation of every estimate against the camera ground truth.
   std::string report = fmt::format("# driftlab run: {}\n\n{}\n\n", sc.name, sc.description);
@@ -323,7 +339,9 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
       ft.columns[1].push_back(rad2deg(platform[k].pitch_rad));
       ft.columns[2].push_back(rad2deg(platform[k].roll_rad));
       const vo::VoResult& r = src.results[k];
-      ft.columns[3].push_back(r.valid ? r.inliers : std::numeric_limits<double>::quiet_NaN());
+      // Covariate f: inlier features (sparse, river paper Table 4), pixels with valid depth (dense).
+      const double f = tr.name.rfind("dense", 0) == 0 ? r.valid_depth_pixels : r.inliers;
+      ft.columns[3].push_back(r.valid ? f : std::numeric_limits<double>::quiet_NaN());
       ft.columns[4].push_back(r.valid ? r.mean_inlier_depth_m
                                       : std::numeric_limits<double>::quiet_NaN());
     }
@@ -409,7 +427,8 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
 
   const bool run_vo = !options.only_motion && !sc.pipeline.vo.empty() && !camera_gt.empty();
   if (run_vo)
-    run_vision_stages(sc, *scene, camera_gt, platform, dir.path(), options, &summary, &metrics);
+    run_vision_stages(sc, *scene, sensor_data, camera_gt, platform, dir.path(), options, &summary,
+                      &metrics);
 
   summary.total_s = seconds_since(t0);
   metrics["version"] = DRIFTLAB_VERSION;

@@ -10,11 +10,14 @@
 #include "core/yaml_io.hpp"
 #include "eval/eval_options.hpp"
 #include "fusion/ca_smoother.hpp"
+#include "fusion/eskf.hpp"
+#include "fusion/ned_filters.hpp"
 #include "scenes/scene_options.hpp"
 #include "sim/render/render_options.hpp"
 #include "sim/sensors/sensor_options.hpp"
 #include "sim/vessel/vessel_options.hpp"
 #include "sim/waves/wave_options.hpp"
+#include "vo/dense/dense_options.hpp"
 #include "vo/pnp/pnp_options.hpp"
 #include "vo/sparse/sparse_options.hpp"
 
@@ -42,7 +45,11 @@ struct PipelineOptions {
   // Options of each algorithm (used when it runs).
   vo::SparseVoOptions sparse;
   vo::PnpVoOptions pnp;
+  vo::DenseVoOptions dense;
   fusion::CaSmootherOptions ca_smoother;
+  fusion::NedFilterOptions ned_kf;
+  fusion::NedParticleFilterOptions ned_pf;
+  fusion::EskfOptions eskf;
 
   template <class A>
   void visit(A& a) {
@@ -52,8 +59,12 @@ struct PipelineOptions {
       yaml::non_negative());
     a("sparse", sparse, "Options of the sparse VO (river paper Section 2.3.1)");
     a("pnp", pnp, "Options of the GFTT+PnP VO (basin paper Section 3.1)");
+    a("dense", dense, "Options of the dense photometric VO (river paper Section 2.3.2)");
     a("ca_smoother", ca_smoother,
       "Options of the constant-acceleration smoother (river paper Eqs. (4)-(5))");
+    a("ned_kf", ned_kf, "Options of the NED Kalman filter (basin paper Section 3.1.1)");
+    a("ned_pf", ned_pf, "Options of the NED particle filter (basin paper Section 3.1.2)");
+    a("eskf", eskf, "Options of the error-state VO + IMU + GPS + compass filter");
   }
 };
 

@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "tests/vo/vo_test_sequences.hpp"
+#include "vo/dense/dense_vo.hpp"
 #include "vo/pnp/pnp_vo.hpp"
 #include "vo/sparse/sparse_vo.hpp"
 #include "vo/stereo_odometry.hpp"
@@ -45,7 +46,14 @@ struct PnpFactory {
   }
 };
 
-using Implementations = ::testing::Types<SparseFactory, PnpFactory>;
+struct DenseFactory {
+  static std::unique_ptr<StereoOdometry> make(const StereoRig& rig) {
+    return std::make_unique<DenseStereoOdometry>(rig, DenseVoOptions{},
+                                                 RngStreams(2015).stream("vo.dense"));
+  }
+};
+
+using Implementations = ::testing::Types<SparseFactory, PnpFactory, DenseFactory>;
 
 // Rendering dominates the suite's run time: each sequence is rendered once per process.
 const test::Sequence& straight_640() {

@@ -1,0 +1,38 @@
+// The filters of a run that read more than one VO (pipeline.fusion: ned_kf, ned_pf, eskf):
+// each follows one VO track frame by frame, with the compass, IMU and GPS measurements of the
+// sensors stage fed in time order. Filters see measurements only, never ground truth; the
+// start position is the run's anchor (the true first pose, as for every VO track, so that
+// the estimates overlay), the start attitude comes from the sensors.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+
+#include "core/rng.hpp"
+#include "core/se3.hpp"
+#include "pipeline/scenario.hpp"
+#include "pipeline/sensor_stage.hpp"
+#include "vo/stereo_odometry.hpp"
+
+namespace driftlab::pipeline {
+
+class FilterTrack {
+ public:
+  /// `T_W_B0`: the anchor, the body pose at the first frame.
+  FilterTrack(FusionAlgorithm kind, const Scenario& sc, const SensorData& sensors,
+              const SE3& T_W_B0, const RngStreams& rng);
+  ~FilterTrack();
+  FilterTrack(FilterTrack&&) noexcept;
+
+  /// Frame at t_ns (times increasing) with its VO result; returns the left camera's pose.
+  SE3 step(TimeNs t_ns, const vo::VoResult& vo);
+  /// NED filters: writes their per-step state (N, E, u, v, heading) as CSV at `path`.
+  void write_states(const std::filesystem::path& path) const;
+  bool writes_states() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace driftlab::pipeline

@@ -1,0 +1,205 @@
+#include "vo/dense/dense_vo.hpp"
+
+#include <chrono>
+#include <memory>
+#include <cmath>
+#include <utility>
+
+
+#include "core/error.hpp"
+#include "vo/dense/disparity.hpp"
+#include "vo/dense/photometric.hpp"
+
+namespace driftlab::vo {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// Coarsest level side below which the alignment has too little to work with.
+constexpr int kMinLevelSidePx = 8;
+
+}  // namespace
+
+struct DenseStereoOdometry::Impl {
+  // What one pair leaves behind: the current pair's, then (swapped) the previous pair's.
+  struct FrameData {
+    dense::Pyramid pyramid;
+    cv::Mat disparity;  // CV_32FC1 [px]
+    dense::Reference ref;
+  };
+
+  Impl(const StereoRig& rig_in, const DenseVoOptions& options_in)
+      : rig(rig_in), options(options_in) {
+    const DenseVoOptions& o = options;
+    dense::DisparityOptions d;
+    d.num_disparities = o.sgbm_num_disparities_px;
+    d.block_size = o.sgbm_block_size_px;
+    d.p1 = o.sgbm_p1;
+    d.p2 = o.sgbm_p2;
+    d.disp12_max_diff = o.sgbm_disp12_max_diff_px;
+    d.pre_filter_cap = o.sgbm_pre_filter_cap;
+    d.uniqueness_ratio = o.sgbm_uniqueness_ratio_pct;
+    d.speckle_window = o.sgbm_speckle_window_px;
+    d.speckle_range = o.sgbm_speckle_range_px;
+    d.full_dp = o.sgbm_mode == DenseSgbmMode::kHh;
+    d.refine_iterations = o.use_refine_disparity() ? o.refine_iterations : 0;
+    d.refine_window = o.refine_window_px;
+    d.refine_max_change = o.refine_max_change_px;
+    stereo = std::make_unique<dense::DisparityEstimator>(d);
+    for (FrameData* f : {&a, &b}) f->pyramid.configure(rig.camera, o.pyramid_scales);
+    selection.min_disparity_px = o.min_disparity_px;
+    selection.gradient_mask = o.use_gradient_mask();
+    selection.min_gradient = o.min_gradient_grey_per_px;
+    selection.lower_mask_fraction = o.effective_lower_mask();
+    align.max_iterations = o.pyramid_max_iterations;
+    align.initial_lambda = o.lm_initial_lambda;
+    align.step_tolerance = o.lm_step_tolerance;
+    align.robust = o.use_robust_weights();
+    align.t_dof = o.t_dof;
+    align.inlier_residual = o.inlier_residual_grey;
+  }
+
+  StereoRig rig;
+  DenseVoOptions options;
+  std::unique_ptr<dense::DisparityEstimator> stereo;
+  dense::RefSelection selection;
+  dense::AlignOptions align;
+  dense::Aligner aligner;
+  FrameData a, b;
+  FrameData* cur = &a;
+  FrameData* prev = &b;
+  bool has_previous = false;
+  // Constant-velocity prior: the last valid motion (T_curr_prev), if the last frame was valid.
+  bool has_velocity = false;
+  SE3 last_T_curr_prev;
+  DenseFrameStats stats;
+};
+
+DenseStereoOdometry::DenseStereoOdometry(const StereoRig& rig, const DenseVoOptions& options,
+                                         Rng /*rng*/) {
+  const std::string rig_problems = validate(rig);
+  if (!rig_problems.empty()) throw UserError("DenseStereoOdometry: invalid rig: " + rig_problems);
+  yaml::validate_or_throw(options, "DenseStereoOdometry");
+  const dense::LevelCamera coarsest = dense::level_camera(rig.camera, options.pyramid_scales[0]);
+  if (coarsest.width < kMinLevelSidePx || coarsest.height < kMinLevelSidePx) {
+    throw UserError("DenseStereoOdometry: pyramid_scales[0] = " +
+                    yaml::format_double(options.pyramid_scales[0]) + " makes the coarsest level " +
+                    std::to_string(coarsest.width) + "x" + std::to_string(coarsest.height) +
+                    " px, expected at least " + std::to_string(kMinLevelSidePx) + " px a side");
+  }
+  if (options.sgbm_num_disparities_px >= rig.camera.width) {
+    throw UserError("DenseStereoOdometry: sgbm_num_disparities_px: got " +
+                    std::to_string(options.sgbm_num_disparities_px) +
+                    ", expected less than the image width " + std::to_string(rig.camera.width));
+  }
+  impl_ = std::make_unique<Impl>(rig, options);
+}
+
+DenseStereoOdometry::~DenseStereoOdometry() = default;
+
+const DenseVoOptions& DenseStereoOdometry::options() const { return impl_->options; }
+const DenseFrameStats& DenseStereoOdometry::last_stats() const { return impl_->stats; }
+const cv::Mat& DenseStereoOdometry::last_disparity() const { return impl_->prev->disparity; }
+
+void DenseStereoOdometry::reset() {
+  impl_->has_previous = false;
+  impl_->has_velocity = false;
+  impl_->last_T_curr_prev = SE3();
+  impl_->stats = {};
+}
+
+VoResult DenseStereoOdometry::process(const StereoFrame& frame) {
+  Impl& s = *impl_;
+  detail::check_image(frame.left, s.rig.camera, "DenseStereoOdometry", "left");
+  detail::check_image(frame.right, s.rig.camera, "DenseStereoOdometry", "right");
+  const auto t_start = Clock::now();
+  VoResult result;
+  s.stats = {};
+  Impl::FrameData& cur = *s.cur;
+
+  // Image preparation: the pyramid of the current left image (target now, reference next).
+  auto t = Clock::now();
+  cur.pyramid.build(frame.left, s.options.pyramid_blur_sigma_px,
+                    s.options.pyramid_area_downscaling);
+  s.stats.pyramid_ms = ms_since(t);
+  result.times.detect_ms = s.stats.pyramid_ms;
+
+  // Stereo correspondence: SGBM disparity of the current pair (refined).
+  t = Clock::now();
+  s.stereo->compute(frame.left, frame.right, cur.pyramid.images.back(), &cur.disparity);
+  s.stats.sgbm_ms = ms_since(t);
+  result.times.match_ms = s.stats.sgbm_ms;
+
+  // Eq. (1) points and Jacobians of the current pair, for the next call; its statistics now.
+  t = Clock::now();
+  dense::build_reference(cur.pyramid, cur.disparity, s.rig.camera.fx * s.rig.baseline_m,
+                         s.selection, &cur.ref);
+  s.stats.reference_ms = ms_since(t);
+  s.stats.valid_depth_pixels = cur.ref.valid_depth_pixels;
+  s.stats.textured_pixels = cur.ref.textured_pixels;
+  s.stats.textured_depth_pixels = cur.ref.textured_depth_pixels;
+
+  // Whatever happens below, this pair is the next call's reference.
+  struct Advance {
+    Impl& s;
+    ~Advance() {
+      std::swap(s.cur, s.prev);
+      s.has_previous = true;
+    }
+  } advance{s};
+
+  auto finish = [&](const char* reason) {
+    result.valid = false;
+    result.reason = reason;
+    result.T_prev_curr = SE3();
+    result.mean_inlier_depth_m = 0.0;
+    s.has_velocity = false;
+    result.times.estimate_ms = s.stats.reference_ms + s.stats.align_ms;
+    result.times.total_ms = ms_since(t_start);
+    return result;
+  };
+
+  if (!s.has_previous) return finish("first frame");
+  const Impl::FrameData& prev = *s.prev;
+  result.valid_depth_pixels = prev.ref.valid_depth_pixels;
+  s.stats.reference_points = static_cast<int>(prev.ref.levels.back().size());
+  if (cur.ref.textured_pixels < s.options.min_textured_pixels)
+    return finish("too little texture in the current left image (black, flat or water?)");
+  if (prev.ref.textured_depth_pixels < s.options.min_textured_pixels)
+    return finish("too few textured pixels with valid depth in the previous frame");
+
+  // Step 2: Levenberg-Marquardt on Eq. (9), coarse to fine.
+  t = Clock::now();
+  SE3 T_curr_prev =
+      s.options.use_constant_velocity() && s.has_velocity ? s.last_T_curr_prev : SE3();
+  const dense::AlignSummary a = s.aligner.align(prev.ref, cur.pyramid, s.align, &T_curr_prev);
+  s.stats.align_ms = ms_since(t);
+  s.stats.iterations = a.iterations;
+  s.stats.rms_residual_grey = a.rms_residual;
+  s.stats.sigma_grey = a.sigma;
+  result.matches = a.used;
+  result.inliers = a.inliers;
+  if (!a.ok) return finish(a.failure);
+  if (a.textured_inliers < s.options.min_textured_pixels ||
+      a.textured_inliers < s.options.min_inlier_fraction * a.textured_used)
+    return finish("photometric residuals too large: the images do not align");
+
+  const SE3 T_prev_curr = T_curr_prev.inverse();
+  if (!detail::is_finite(T_prev_curr) || !std::isfinite(a.mean_inlier_depth_m))
+    return finish("motion estimate not finite");
+  result.valid = true;
+  result.T_prev_curr = T_prev_curr;
+  result.mean_inlier_depth_m = a.mean_inlier_depth_m;
+  s.has_velocity = true;
+  s.last_T_curr_prev = T_curr_prev;
+  result.times.estimate_ms = s.stats.reference_ms + s.stats.align_ms;
+  result.times.total_ms = ms_since(t_start);
+  return result;
+}
+
+}  // namespace driftlab::vo

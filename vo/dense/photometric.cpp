@@ -1,0 +1,467 @@
+#include "vo/dense/photometric.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <Eigen/Cholesky>
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.hpp"
+#include "vo/stereo_odometry.hpp"
+
+namespace driftlab::vo::dense {
+
+LevelCamera level_camera(const PinholeCamera& camera, double scale) {
+  LevelCamera c;
+  c.width = std::max(1, static_cast<int>(std::lround(camera.width * scale)));
+  c.height = std::max(1, static_cast<int>(std::lround(camera.height * scale)));
+  c.sx = static_cast<double>(c.width) / camera.width;
+  c.sy = static_cast<double>(c.height) / camera.height;
+  c.fx = camera.fx * c.sx;
+  c.fy = camera.fy * c.sy;
+  // cv::resize maps destination pixel centres to (x + 0.5) / s - 0.5 in the source.
+  c.cx = (camera.cx + 0.5) * c.sx - 0.5;
+  c.cy = (camera.cy + 0.5) * c.sy - 0.5;
+  return c;
+}
+
+Mat26 warp_jacobian(const Vec3& P, double fx, double fy) {
+  // Eq. (7): u = fx X / Z + cx, v = fy Y / Z + cy; Eq. (6) for the small motion exp(xi):
+  // d(exp(xi) P)/d xi = [I | -hat(P)] at xi = 0.
+  const double iz = 1.0 / P.z();
+  Eigen::Matrix<double, 2, 3> dpi;
+  dpi << fx * iz, 0.0, -fx * P.x() * iz * iz, 0.0, fy * iz, -fy * P.y() * iz * iz;
+  Eigen::Matrix<double, 3, 6> dP;
+  dP << Mat3::Identity(), -hat(P);
+  return dpi * dP;
+}
+
+Row6 photometric_jacobian(double gx, double gy, const Vec3& P, double fx, double fy) {
+  // Expanded form of [gx gy] * warp_jacobian(P): with g = [gx gy] * d pi / d P,
+  // the translation part is g and the rotation part is -g * hat(P) = (P x g)^T.
+  const double iz = 1.0 / P.z();
+  const double a = gx * fx * iz, b = gy * fy * iz;
+  const double c = -(a * P.x() + b * P.y()) * iz;
+  Row6 J;
+  J << a, b, c, P.y() * c - P.z() * b, P.z() * a - P.x() * c, P.x() * b - P.y() * a;
+  return J;
+}
+
+void Pyramid::configure(const PinholeCamera& camera, const std::vector<double>& scales) {
+  cameras.clear();
+  for (const double s : scales) cameras.push_back(level_camera(camera, s));
+  images.resize(cameras.size());
+}
+
+void Pyramid::build(const cv::Mat& gray8, double blur_sigma_px, bool area_downscaling) {
+  DRIFTLAB_DEMAND(!cameras.empty());
+  cv::Mat& full = images.back();  // scale 1 (options validation requires it)
+  gray8.convertTo(full, CV_32F);
+  if (cameras.size() == 1) return;
+  const cv::Mat* src = &full;
+  if (blur_sigma_px > 0.0) {
+    // Kernel truncated at 3 sigma: 19 taps for the paper's sigma of 3.
+    const int k = 2 * static_cast<int>(std::ceil(3.0 * blur_sigma_px)) + 1;
+    cv::GaussianBlur(full, blurred, cv::Size(k, k), blur_sigma_px, blur_sigma_px,
+                     cv::BORDER_REFLECT_101);
+    src = &blurred;
+  }
+  for (std::size_t l = 0; l + 1 < cameras.size(); ++l)
+    cv::resize(*src, images[l], cv::Size(cameras[l].width, cameras[l].height), 0, 0,
+               area_downscaling ? cv::INTER_AREA : cv::INTER_LINEAR);
+}
+
+namespace {
+
+// The full-resolution pixels [first, last] a level pixel covers along one axis: those whose
+// centres lie within half a level pixel of its centre (x + 0.5) / s - 0.5.
+void cover(int level_size, int full_size, double s, std::vector<int>* first,
+           std::vector<int>* last) {
+  first->resize(static_cast<std::size_t>(level_size));
+  last->resize(static_cast<std::size_t>(level_size));
+  const double half = 0.5 / s;
+  for (int i = 0; i < level_size; ++i) {
+    const double c = (i + 0.5) / s - 0.5;
+    int a = static_cast<int>(std::ceil(c - half + 1e-9));
+    int b = static_cast<int>(std::floor(c + half - 1e-9));
+    a = std::clamp(a, 0, full_size - 1);
+    b = std::clamp(b, a, full_size - 1);
+    (*first)[static_cast<std::size_t>(i)] = a;
+    (*last)[static_cast<std::size_t>(i)] = b;
+  }
+}
+
+// Appends the reference pixel (u, v) of a level with gradient (gx, gy), intensity i and
+// disparity D [full-resolution px]: its point by Eq. (1) and its Jacobian row, the expanded
+// photometric_jacobian() in float.
+inline void add_point(float u, float v, float gx, float gy, float i, float D, const LevelCamera& c,
+                      float baseline_fx, RefLevel* out) {
+  // Eq. (1): Z = f B / D, X = Z (p_x - c_x) / f, Y = Z (p_y - c_y) / f (level intrinsics).
+  const float Z = baseline_fx / D;
+  const float X = Z * (u - static_cast<float>(c.cx)) / static_cast<float>(c.fx);
+  const float Y = Z * (v - static_cast<float>(c.cy)) / static_cast<float>(c.fy);
+  const float iz = 1.0f / Z;
+  const float a = gx * static_cast<float>(c.fx) * iz, b = gy * static_cast<float>(c.fy) * iz;
+  const float cz = -(a * X + b * Y) * iz;
+  out->points.push_back({X, Y, Z, i});
+  out->jacobians.push_back(
+      {{a, b, cz, Y * cz - Z * b, Z * a - X * cz, X * b - Y * a, 0.0f, 0.0f}});
+}
+
+}  // namespace
+
+void build_reference(const Pyramid& pyramid, const cv::Mat& disparity, double baseline_fx,
+                     const RefSelection& selection, Reference* out) {
+  DRIFTLAB_DEMAND(disparity.type() == CV_32FC1);
+  const int W = disparity.cols, H = disparity.rows;
+  const std::size_t n_levels = pyramid.cameras.size();
+  DRIFTLAB_DEMAND(pyramid.cameras.back().width == W && pyramid.cameras.back().height == H);
+  out->levels.resize(n_levels);
+  const float min_d = static_cast<float>(selection.min_disparity_px);
+  const float fB = static_cast<float>(baseline_fx);
+  const float g2_textured = static_cast<float>(selection.min_gradient * selection.min_gradient);
+
+  int valid = 0;
+  for (int v = 0; v < H; ++v) {
+    const float* d = disparity.ptr<float>(v);
+    for (int u = 0; u < W; ++u) valid += d[u] >= min_d ? 1 : 0;
+  }
+  out->valid_depth_pixels = valid;
+
+  // Full resolution first (the last level; validation requires scale 1 last): one disparity
+  // per pixel, the texture mask and the frame's texture statistics.
+  {
+    const LevelCamera& c = pyramid.cameras.back();
+    const cv::Mat& I = pyramid.images.back();
+    RefLevel& level = out->levels.back();
+    level.clear();
+    out->textured.create(H, W, CV_8UC1);
+    out->textured.row(0).setTo(0);
+    out->textured.row(H - 1).setTo(0);
+    const int v_end = std::min(
+        H - 1, static_cast<int>(std::ceil((1.0 - selection.lower_mask_fraction) * H)));
+    int textured = 0, both = 0;
+    for (int v = 1; v < H - 1; ++v) {
+      const float* row = I.ptr<float>(v);
+      const float* up = I.ptr<float>(v - 1);
+      const float* down = I.ptr<float>(v + 1);
+      const float* d = disparity.ptr<float>(v);
+      std::uint8_t* mask = out->textured.ptr<std::uint8_t>(v);
+      mask[0] = mask[W - 1] = 0;
+      const bool in_rows = v < v_end;
+      for (int u = 1; u < W - 1; ++u) {
+        const float gx = 0.5f * (row[u + 1] - row[u - 1]);
+        const float gy = 0.5f * (down[u] - up[u]);
+        const bool is_textured = gx * gx + gy * gy >= g2_textured;
+        const bool has_depth = d[u] >= min_d;
+        mask[u] = is_textured ? 1 : 0;
+        textured += is_textured ? 1 : 0;
+        both += is_textured && has_depth ? 1 : 0;
+        if (!in_rows || !has_depth || (selection.gradient_mask && !is_textured)) continue;
+        add_point(static_cast<float>(u), static_cast<float>(v), gx, gy, row[u], d[u], c, fB,
+                  &level);
+        level.textured.push_back(is_textured ? 1 : 0);
+      }
+    }
+    out->textured_pixels = textured;
+    out->textured_depth_pixels = both;
+  }
+
+  std::vector<int>& col_first = out->col_first;
+  std::vector<int>& col_last = out->col_last;
+  std::vector<int>& row_first = out->row_first;
+  std::vector<int>& row_last = out->row_last;
+  for (std::size_t l = 0; l + 1 < n_levels; ++l) {
+    const LevelCamera& c = pyramid.cameras[l];
+    const cv::Mat& I = pyramid.images[l];
+    RefLevel& level = out->levels[l];
+    level.clear();
+    cover(c.width, W, c.sx, &col_first, &col_last);
+    cover(c.height, H, c.sy, &row_first, &row_last);
+    const int v_end = std::min(
+        c.height - 1,
+        static_cast<int>(std::ceil((1.0 - selection.lower_mask_fraction) * c.height)));
+    for (int v = 1; v < v_end; ++v) {
+      const float* row = I.ptr<float>(v);
+      const float* up = I.ptr<float>(v - 1);
+      const float* down = I.ptr<float>(v + 1);
+      const int r0 = row_first[static_cast<std::size_t>(v)];
+      const int r1 = row_last[static_cast<std::size_t>(v)];
+      for (int u = 1; u < c.width - 1; ++u) {
+        const int c0 = col_first[static_cast<std::size_t>(u)];
+        const int c1 = col_last[static_cast<std::size_t>(u)];
+        float sum = 0.0f;
+        int n_textured = 0;
+        bool all_valid = true;
+        for (int y = r0; y <= r1 && all_valid; ++y) {
+          const float* d = disparity.ptr<float>(y);
+          const std::uint8_t* mask = out->textured.ptr<std::uint8_t>(y);
+          for (int x = c0; x <= c1; ++x) {
+            if (!(d[x] >= min_d)) {
+              all_valid = false;
+              break;
+            }
+            sum += d[x];
+            n_textured += mask[x];
+          }
+        }
+        const int n = (r1 - r0 + 1) * (c1 - c0 + 1);
+        if (!all_valid || (selection.gradient_mask && 2 * n_textured < n)) continue;
+        const float gx = 0.5f * (row[u + 1] - row[u - 1]);
+        const float gy = 0.5f * (down[u] - up[u]);
+        add_point(static_cast<float>(u), static_cast<float>(v), gx, gy, row[u],
+                  sum / static_cast<float>(n), c, fB, &level);
+      }
+    }
+  }
+}
+
+double Aligner::cost_scale() const {
+  // With w = (nu + 1) / (nu + r^2 / sigma^2), the surrogate r^2 / (1 + r^2 / (nu sigma^2)) of
+  // warp() is nu / (nu + 1) w r^2.
+  return options_.robust ? options_.t_dof / (options_.t_dof + 1.0) : 1.0;
+}
+
+int Aligner::warp(const RefLevel& level, const cv::Mat& image, const LevelCamera& cam,
+                  const SE3& T, double sigma2, std::vector<float>* residuals,
+                  double* cost) const {
+  const std::vector<RefPoint>& points = level.points;
+  residuals->resize(points.size());
+  const Eigen::Matrix3f R = T.rotation().cast<float>();
+  const Eigen::Vector3f t = T.translation().cast<float>();
+  const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
+  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
+  const float umax = static_cast<float>(image.cols - 1), vmax = static_cast<float>(image.rows - 1);
+  const float* base = image.ptr<float>(0);
+  const std::size_t stride = image.step1();
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  float* out = residuals->data();
+  int used = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const RefPoint& p = points[i];
+    // Eq. (6), G = R P + T, then Eq. (7).
+    const float qx = R(0, 0) * p.x + R(0, 1) * p.y + R(0, 2) * p.z + t.x();
+    const float qy = R(1, 0) * p.x + R(1, 1) * p.y + R(1, 2) * p.z + t.y();
+    const float qz = R(2, 0) * p.x + R(2, 1) * p.y + R(2, 2) * p.z + t.z();
+    const float iz = 1.0f / qz;
+    const float u = fx * qx * iz + cx, v = fy * qy * iz + cy;
+    if (!(qz > 1e-3f) || !(u >= 0.0f && u < umax && v >= 0.0f && v < vmax)) {
+      out[i] = kNaN;
+      continue;
+    }
+    // Eq. (9)'s residual: the current image at the warped pixel (Eq. (8)), bilinear, minus the
+    // reference.
+    const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
+    const float ax = u - static_cast<float>(x0), ay = v - static_cast<float>(y0);
+    const float* q0 = base + static_cast<std::size_t>(y0) * stride + x0;
+    const float* q1 = q0 + stride;
+    const float top = q0[0] + ax * (q0[1] - q0[0]);
+    const float bottom = q1[0] + ax * (q1[1] - q1[0]);
+    out[i] = top + ay * (bottom - top) - p.intensity;
+    ++used;
+  }
+  // The step-acceptance cost: r^2 (least squares) or a bounded surrogate of the
+  // t-distribution's negative log-likelihood with the same quadratic core (its log would cost
+  // more than the warp itself). A separate branch-free pass, so that it vectorises.
+  const float inv_nu_s2 =
+      options_.robust ? static_cast<float>(1.0 / (options_.t_dof * std::max(sigma2, 1e-12)))
+                      : 0.0f;
+  double sum = 0.0;
+  constexpr std::size_t kBlock = 1024;
+  for (std::size_t begin = 0; begin < points.size(); begin += kBlock) {
+    const std::size_t end = std::min(points.size(), begin + kBlock);
+    float block = 0.0f;
+    for (std::size_t i = begin; i < end; ++i) {
+      const float r = out[i];
+      const float rho = r * r / (1.0f + r * r * inv_nu_s2);
+      block += r == r ? rho : 0.0f;  // NaN: not compared
+    }
+    sum += block;
+  }
+  *cost = sum / std::max(used, 1);
+  return used;
+}
+
+double Aligner::estimate_sigma2(const std::vector<float>& residuals, int used,
+                                double sigma2) const {
+  // Kerl et al. 2013, Eq. (14): sigma^2 = 1/n sum r^2 (nu + 1) / (nu + (r / sigma)^2), a fixed
+  // point iterated from the previous scale; 1% is far below what changes the weights.
+  const float nf = static_cast<float>(options_.t_dof);
+  constexpr double kFloor = 1e-4;  // (0.01 grey)^2: exact alignments have zero residuals
+  sigma2 = std::max(sigma2, kFloor);
+  for (int it = 0; it < 5; ++it) {
+    const float inv = static_cast<float>(1.0 / sigma2);
+    double sum = 0.0;
+    constexpr std::size_t kBlock = 1024;
+    for (std::size_t begin = 0; begin < residuals.size(); begin += kBlock) {
+      const std::size_t end = std::min(residuals.size(), begin + kBlock);
+      float block = 0.0f;
+      for (std::size_t i = begin; i < end; ++i) {
+        const float r = residuals[i];
+        const float term = r * r * (nf + 1.0f) / (nf + r * r * inv);
+        block += r == r ? term : 0.0f;  // NaN: not compared
+      }
+      sum += block;
+    }
+    const double next = std::max(sum / std::max(used, 1), kFloor);
+    const bool done = std::abs(next - sigma2) < 1e-2 * sigma2;
+    sigma2 = next;
+    if (done) break;
+  }
+  return sigma2;
+}
+
+void Aligner::normal_equations(const RefLevel& level, const std::vector<float>& residuals,
+                               double sigma2, Normal* n) const {
+  // Per point, with a = J[0..3] and b = (J[4], J[5], r, 0): the products w a a_c, w b a_c
+  // (c < 4) and w b b_c (c < 3) hold every entry of w [J r]^T [J r] once, in 11 packet
+  // multiply-adds. Sums run in float over blocks of points and in double across blocks: float
+  // alone loses digits over 300k points, double alone halves the throughput. The order is
+  // fixed, so the bytes are too.
+  using P4 = Eigen::Array<float, 4, 1>;
+  double lo_sum[4][4] = {}, hi_sum[7][4] = {};
+  const float nu = static_cast<float>(options_.t_dof);
+  const float inv = options_.robust ? static_cast<float>(1.0 / sigma2) : 0.0f;
+  const bool robust = options_.robust;
+  const std::size_t n_points = level.size();
+  constexpr std::size_t kBlock = 256;
+  for (std::size_t begin = 0; begin < n_points; begin += kBlock) {
+    P4 lo[4], hi[7];
+    for (P4& x : lo) x.setZero();
+    for (P4& x : hi) x.setZero();
+    const std::size_t end = std::min(n_points, begin + kBlock);
+    for (std::size_t i = begin; i < end; ++i) {
+      const float r = residuals[i];
+      if (std::isnan(r)) continue;
+      // Kerl et al. 2013: w = (nu + 1) / (nu + (r / sigma)^2); 1 for plain least squares.
+      const float w = robust ? (nu + 1.0f) / (nu + r * r * inv) : 1.0f;
+      const float* J = level.jacobians[i].J;
+      const P4 a = Eigen::Map<const P4, Eigen::Aligned16>(J);
+      P4 b = Eigen::Map<const P4, Eigen::Aligned16>(J + 4);
+      b[2] = r;
+      const P4 wa = w * a, wb = w * b;
+      for (int c = 0; c < 4; ++c) {
+        lo[c] += wa * a[c];
+        hi[c] += wb * a[c];
+      }
+      for (int c = 0; c < 3; ++c) hi[4 + c] += wb * b[c];
+    }
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 4; ++k) lo_sum[c][k] += lo[c][k];
+    for (int c = 0; c < 7; ++c)
+      for (int k = 0; k < 4; ++k) hi_sum[c][k] += hi[c][k];
+  }
+  for (int a = 0; a < 4; ++a)
+    for (int c = 0; c < 4; ++c) n->H[a][c] = lo_sum[c][a];
+  for (int k = 0; k < 2; ++k) {
+    for (int c = 0; c < 4; ++c) n->H[4 + k][c] = n->H[c][4 + k] = hi_sum[c][k];
+    for (int m = 0; m < 2; ++m) n->H[4 + k][4 + m] = hi_sum[4 + m][k];
+  }
+  for (int c = 0; c < 6; ++c) n->b[c] = hi_sum[c][2];
+  n->wrr = hi_sum[6][2];
+}
+
+AlignSummary Aligner::align(const Reference& ref, const Pyramid& current,
+                            const AlignOptions& options, SE3* T_curr_prev) {
+  DRIFTLAB_DEMAND(ref.levels.size() == current.images.size());
+  DRIFTLAB_DEMAND(options.max_iterations.size() == current.images.size());
+  options_ = options;
+  AlignSummary s;
+  SE3 T = *T_curr_prev;
+  constexpr int kMinPoints = 6;
+  double sigma2 = 1.0;
+  const std::size_t n_levels = ref.levels.size();
+  for (std::size_t l = 0; l < n_levels; ++l) {
+    const RefLevel& level = ref.levels[l];
+    const cv::Mat& image = current.images[l];
+    const LevelCamera& cam = current.cameras[l];
+    const bool finest = l + 1 == n_levels;
+    double c = 0.0;
+    int used = warp(level, image, cam, T, sigma2, &res_, &c);
+    if (used < kMinPoints) {
+      if (!finest) continue;  // a coarse level can be empty; the finer ones decide
+      s.failure = "too few reference pixels project into the current image";
+      return s;
+    }
+    Normal ne;
+    if (options.robust) {
+      // A fresh scale per level: blur makes the coarse levels' residuals smaller.
+      double mean2 = 0.0;
+      for (const float r : res_)
+        if (!std::isnan(r)) mean2 += static_cast<double>(r) * r;
+      sigma2 = estimate_sigma2(res_, used, mean2 / used);
+    }
+    normal_equations(level, res_, sigma2, &ne);
+    c = cost_scale() * ne.wrr / used;
+    double lambda = options.initial_lambda;
+    for (int it = 0; it < options.max_iterations[l]; ++it) {
+      ++s.iterations;
+      Eigen::Matrix<double, 6, 6> A;
+      Vec6 rhs;
+      for (int a = 0; a < 6; ++a) {
+        rhs[a] = ne.b[a];
+        for (int b = 0; b < 6; ++b) A(a, b) = ne.H[a][b];
+        // Marquardt's scaling: damp each parameter by its own curvature.
+        A(a, a) += lambda * ne.H[a][a];
+      }
+      const Vec6 xi = A.ldlt().solve(rhs);
+      if (!xi.allFinite()) break;
+      const bool converged = xi.norm() < options.step_tolerance;
+      const bool last = converged || it + 1 == options.max_iterations[l];
+      // Inverse compositional update: T <- T exp(xi)^-1.
+      const SE3 T_try = T * SE3::exp(xi).inverse();
+      double c_try = 0.0;
+      const int used_try = warp(level, image, cam, T_try, sigma2, &res_try_, &c_try);
+      if (used_try >= kMinPoints && c_try < c) {
+        T = T_try;
+        std::swap(res_, res_try_);
+        used = used_try;
+        c = c_try;
+        // The level ends here: no next step needs the normal equations.
+        if (!last) {
+          if (options.robust) sigma2 = estimate_sigma2(res_, used, sigma2);
+          normal_equations(level, res_, sigma2, &ne);
+          c = cost_scale() * ne.wrr / used;
+        }
+        lambda = std::max(lambda * 0.1, 1e-12);
+      } else {
+        lambda = std::max(lambda * 10.0, 1e-6);
+      }
+      if (converged) break;
+    }
+    if (finest) {
+      // Statistics of the final motion, from the residuals of the accepted state.
+      s.used = used;
+      const float thr = static_cast<float>(options.inlier_residual);
+      const Eigen::Matrix3f R = T.rotation().cast<float>();
+      const Eigen::Vector3f t = T.translation().cast<float>();
+      double depth = 0.0, sq = 0.0;
+      for (std::size_t i = 0; i < level.size(); ++i) {
+        const float r = res_[i];
+        if (std::isnan(r)) continue;
+        sq += static_cast<double>(r) * r;
+        const bool textured = level.textured[i] != 0;
+        s.textured_used += textured ? 1 : 0;
+        if (std::abs(r) > thr) continue;
+        ++s.inliers;
+        s.textured_inliers += textured ? 1 : 0;
+        const RefPoint& p = level.points[i];
+        depth += R(2, 0) * p.x + R(2, 1) * p.y + R(2, 2) * p.z + t.z();
+      }
+      s.mean_inlier_depth_m = s.inliers > 0 ? depth / s.inliers : 0.0;
+      s.rms_residual = std::sqrt(sq / used);
+      s.sigma = options.robust ? std::sqrt(sigma2) : 0.0;
+    }
+  }
+  if (!::driftlab::vo::detail::is_finite(T)) {
+    s.failure = "motion estimate not finite";
+    return s;
+  }
+  s.ok = true;
+  *T_curr_prev = T;
+  return s;
+}
+
+}  // namespace driftlab::vo::dense
