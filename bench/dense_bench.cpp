@@ -194,8 +194,8 @@ const Depths& depths() {
       for (int v = 0; v < depth.rows; ++v)
         for (int u = 0; u < depth.cols; ++u) {
           const float dd = disparity.at<float>(v, u);
-          depth.at<float>(v, u) = dd >= min_d ? static_cast<float>(fB / dd)
-                                              : std::numeric_limits<float>::quiet_NaN();
+          depth.at<float>(v, u) =
+              dd >= min_d ? static_cast<float>(fB / dd) : std::numeric_limits<float>::quiet_NaN();
         }
       out.disparity.push_back(disparity);
       out.depth.push_back(depth);

@@ -43,12 +43,12 @@ struct DenseVoOptions {
   DenseMethod method = DenseMethod::kExtended;
 
   // --- disparity: semi-global block matching (paper: [49], no parameters given) ----------------
-  int sgbm_num_disparities_px = 64;  // ours: depths from f B / 64 (0.94 m on the 640x480 rig)
-  int sgbm_block_size_px = 5;        // OpenCV: 3..11; 5 keeps thin structures
-  int sgbm_p1 = 200;                 // OpenCV: 8 * block^2
-  int sgbm_p2 = 800;                 // OpenCV: 32 * block^2
-  int sgbm_disp12_max_diff_px = 1;   // left-right check; OpenCV's usual value
-  int sgbm_pre_filter_cap = 63;      // OpenCV
+  int sgbm_num_disparities_px = 64;    // ours: depths from f B / 64 (0.94 m on the 640x480 rig)
+  int sgbm_block_size_px = 5;          // OpenCV: 3..11; 5 keeps thin structures
+  int sgbm_p1 = 200;                   // OpenCV: 8 * block^2
+  int sgbm_p2 = 800;                   // OpenCV: 32 * block^2
+  int sgbm_disp12_max_diff_px = 1;     // left-right check; OpenCV's usual value
+  int sgbm_pre_filter_cap = 63;        // OpenCV
   int sgbm_uniqueness_ratio_pct = 10;  // OpenCV: 5..15
   int sgbm_speckle_window_px = 100;    // OpenCV: 50..200
   int sgbm_speckle_range_px = 2;       // OpenCV: 1 or 2
@@ -62,27 +62,27 @@ struct DenseVoOptions {
   // paper: bilinear. A sigma of 3 px leaves the 1/8 level aliased (its pixels are 8 px wide);
   // averaging instead extends the yaw rate the 640x480 rig tracks from 4 to 5 deg/frame.
   bool pyramid_area_downscaling = false;
-  double lm_initial_lambda = 1e-4;   // ours: Gauss-Newton steps are good from the start
-  double lm_step_tolerance = 1e-6;   // ours: 1 um / 1 urad, 100x below the errors reached
+  double lm_initial_lambda = 1e-4;  // ours: Gauss-Newton steps are good from the start
+  double lm_step_tolerance = 1e-6;  // ours: 1 um / 1 urad, far below the errors reached
 
   // --- beyond the paper (method: extended) ------------------------------------------------------
   // ours: SGBM's sub-pixel disparities are biased by up to 0.2-0.3 px on tests/vo's scenes, and
   // a disparity error moves a warped pixel by |t| / B times as much (4 px per px at 0.5 m/frame
   // on the paper's rig), whatever the depth; refinement brings the bias below ~0.02 px.
   bool refine_disparity = true;
-  int refine_iterations = 1;       // ours: more iterations add noise, not accuracy
-  int refine_window_px = 9;        // ours
+  int refine_iterations = 1;          // ours: more iterations add noise, not accuracy
+  int refine_window_px = 9;           // ours
   double refine_max_change_px = 1.0;  // ours: a larger change means SGBM's match was wrong
-  bool robust_weights = true;    // Kerl et al. 2013: t-distribution weights
-  double t_dof = 5.0;            // Kerl et al. 2013: nu = 5
-  bool constant_velocity = true;  // start from the last motion rather than the identity
-  bool gradient_mask = true;      // keep only pixels whose gradient reaches min_gradient below
-  double mask_lower_fraction = 0.0;  // ours: 0 (the test scenes' lower image is textured ground)
+  bool robust_weights = true;         // Kerl et al. 2013: t-distribution weights
+  double t_dof = 5.0;                 // Kerl et al. 2013: nu = 5
+  bool constant_velocity = true;      // start from the last motion rather than the identity
+  bool gradient_mask = true;          // keep only pixels whose gradient reaches min_gradient below
+  double mask_lower_fraction = 0.0;   // ours: 0 (the test scenes' lower image is textured ground)
 
   // --- validity of a result (both methods) -------------------------------------------------------
   // ours: tests/vo's water renders peak at 0.71 grey/px (8-bit steps of smooth ripples); a
   // quarter of the textured banks' pixels reach 5 grey/px, and aligning those alone is as
-  // accurate as aligning the 70% above 2 grey/px, in 40% of the time (bench/dense_bench.cpp).
+  // accurate as aligning the 70% above 2 grey/px, in under half the time (bench/dense_bench.cpp).
   // Also above the gradients of 2-3 grey levels of sensor noise.
   double min_gradient_grey_per_px = 5.0;
   int min_textured_pixels = 2000;      // ours: ~1% of a 640x480 image
@@ -100,9 +100,7 @@ struct DenseVoOptions {
   }
 
   /// True when a beyond-the-paper switch is in effect (method extended and the switch on).
-  bool use_refine_disparity() const {
-    return method == DenseMethod::kExtended && refine_disparity;
-  }
+  bool use_refine_disparity() const { return method == DenseMethod::kExtended && refine_disparity; }
   bool use_robust_weights() const { return method == DenseMethod::kExtended && robust_weights; }
   bool use_constant_velocity() const {
     return method == DenseMethod::kExtended && constant_velocity;

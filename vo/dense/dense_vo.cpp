@@ -1,10 +1,9 @@
 #include "vo/dense/dense_vo.hpp"
 
 #include <chrono>
-#include <memory>
 #include <cmath>
+#include <memory>
 #include <utility>
-
 
 #include "core/error.hpp"
 #include "vo/dense/disparity.hpp"

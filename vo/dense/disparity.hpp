@@ -17,9 +17,9 @@ struct DisparityOptions {
   int uniqueness_ratio = 10;
   int speckle_window = 100;
   int speckle_range = 2;
-  bool full_dp = false;           ///< MODE_HH instead of MODE_SGBM
-  int refine_iterations = 0;      ///< 0: SGBM's own sub-pixel disparity
-  int refine_window = 9;          ///< side of the refinement window [px], odd
+  bool full_dp = false;            ///< MODE_HH instead of MODE_SGBM
+  int refine_iterations = 0;       ///< 0: SGBM's own sub-pixel disparity
+  int refine_window = 9;           ///< side of the refinement window [px], odd
   double refine_max_change = 1.0;  ///< a larger total change invalidates the pixel [px]
 };
 

@@ -106,8 +106,7 @@ inline void add_point(float u, float v, float gx, float gy, float i, float D, co
   const float a = gx * static_cast<float>(c.fx) * iz, b = gy * static_cast<float>(c.fy) * iz;
   const float cz = -(a * X + b * Y) * iz;
   out->points.push_back({X, Y, Z, i});
-  out->jacobians.push_back(
-      {{a, b, cz, Y * cz - Z * b, Z * a - X * cz, X * b - Y * a, 0.0f, 0.0f}});
+  out->jacobians.push_back({{a, b, cz, Y * cz - Z * b, Z * a - X * cz, X * b - Y * a, 0.0f, 0.0f}});
 }
 
 }  // namespace
@@ -140,8 +139,8 @@ void build_reference(const Pyramid& pyramid, const cv::Mat& disparity, double ba
     out->textured.create(H, W, CV_8UC1);
     out->textured.row(0).setTo(0);
     out->textured.row(H - 1).setTo(0);
-    const int v_end = std::min(
-        H - 1, static_cast<int>(std::ceil((1.0 - selection.lower_mask_fraction) * H)));
+    const int v_end =
+        std::min(H - 1, static_cast<int>(std::ceil((1.0 - selection.lower_mask_fraction) * H)));
     int textured = 0, both = 0;
     for (int v = 1; v < H - 1; ++v) {
       const float* row = I.ptr<float>(v);
@@ -180,9 +179,9 @@ void build_reference(const Pyramid& pyramid, const cv::Mat& disparity, double ba
     level.clear();
     cover(c.width, W, c.sx, &col_first, &col_last);
     cover(c.height, H, c.sy, &row_first, &row_last);
-    const int v_end = std::min(
-        c.height - 1,
-        static_cast<int>(std::ceil((1.0 - selection.lower_mask_fraction) * c.height)));
+    const int v_end =
+        std::min(c.height - 1,
+                 static_cast<int>(std::ceil((1.0 - selection.lower_mask_fraction) * c.height)));
     for (int v = 1; v < v_end; ++v) {
       const float* row = I.ptr<float>(v);
       const float* up = I.ptr<float>(v - 1);
@@ -224,9 +223,8 @@ double Aligner::cost_scale() const {
   return options_.robust ? options_.t_dof / (options_.t_dof + 1.0) : 1.0;
 }
 
-int Aligner::warp(const RefLevel& level, const cv::Mat& image, const LevelCamera& cam,
-                  const SE3& T, double sigma2, std::vector<float>* residuals,
-                  double* cost) const {
+int Aligner::warp(const RefLevel& level, const cv::Mat& image, const LevelCamera& cam, const SE3& T,
+                  double sigma2, std::vector<float>* residuals, double* cost) const {
   const std::vector<RefPoint>& points = level.points;
   residuals->resize(points.size());
   const Eigen::Matrix3f R = T.rotation().cast<float>();
@@ -266,8 +264,7 @@ int Aligner::warp(const RefLevel& level, const cv::Mat& image, const LevelCamera
   // t-distribution's negative log-likelihood with the same quadratic core (its log would cost
   // more than the warp itself). A separate branch-free pass, so that it vectorises.
   const float inv_nu_s2 =
-      options_.robust ? static_cast<float>(1.0 / (options_.t_dof * std::max(sigma2, 1e-12)))
-                      : 0.0f;
+      options_.robust ? static_cast<float>(1.0 / (options_.t_dof * std::max(sigma2, 1e-12))) : 0.0f;
   double sum = 0.0;
   constexpr std::size_t kBlock = 1024;
   for (std::size_t begin = 0; begin < points.size(); begin += kBlock) {

@@ -107,7 +107,7 @@ struct RefSelection {
 
 /// The reference points of every level of one frame, and the frame's statistics.
 struct Reference {
-  std::vector<RefLevel> levels;  ///< coarsest first, as the pyramid
+  std::vector<RefLevel> levels;   ///< coarsest first, as the pyramid
   int valid_depth_pixels = 0;     ///< full-resolution pixels with disparity >= min (covariate f)
   int textured_pixels = 0;        ///< full-resolution pixels with |grad I| >= min_gradient
   int textured_depth_pixels = 0;  ///< of those, with a valid depth
@@ -137,11 +137,11 @@ struct AlignOptions {
 /// Outcome of one alignment. The statistics are of the finest level at the final motion.
 struct AlignSummary {
   bool ok = false;
-  const char* failure = "";  ///< why not, when !ok
-  int used = 0;              ///< reference points that project into the current image
-  int inliers = 0;           ///< of those, |r| <= inlier_residual
-  int textured_used = 0;     ///< used points that are textured (RefLevel::textured)
-  int textured_inliers = 0;  ///< of those, inliers
+  const char* failure = "";          ///< why not, when !ok
+  int used = 0;                      ///< reference points that project into the current image
+  int inliers = 0;                   ///< of those, |r| <= inlier_residual
+  int textured_used = 0;             ///< used points that are textured (RefLevel::textured)
+  int textured_inliers = 0;          ///< of those, inliers
   double mean_inlier_depth_m = 0.0;  ///< mean depth of the inliers in the current frame
   double rms_residual = 0.0;         ///< of the used points [grey]
   double sigma = 0.0;                ///< t-distribution scale at the end [grey]; 0 if not robust
@@ -169,8 +169,8 @@ class Aligner {
   int warp(const RefLevel& level, const cv::Mat& image, const LevelCamera& cam, const SE3& T,
            double sigma2, std::vector<float>* residuals, double* cost) const;
   double estimate_sigma2(const std::vector<float>& residuals, int used, double sigma2) const;
-  void normal_equations(const RefLevel& level, const std::vector<float>& residuals,
-                        double sigma2, Normal* n) const;
+  void normal_equations(const RefLevel& level, const std::vector<float>& residuals, double sigma2,
+                        Normal* n) const;
   // The step-acceptance cost of a residual set is cost_scale() * sum w r^2 / used.
   double cost_scale() const;
 
