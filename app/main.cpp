@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "app/sweep_commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/trajectory_io.hpp"
@@ -163,8 +164,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> run_sets;
   bool run_force = false;
   auto* run_cmd = app.add_subcommand("run", "Run one scenario end to end into an output folder");
-  run_cmd->add_option("SCENARIO", run_file, "Scenario YAML file")->required();
-  run_cmd->add_option("--out", run_out, "Output folder (written atomically)")->required();
+  auto* run_scenario_opt = run_cmd->add_option("SCENARIO", run_file, "Scenario YAML file");
+  auto* run_out_opt = run_cmd->add_option("--out", run_out, "Output folder (written atomically)");
   run_cmd->add_option("--set", run_sets, "Override a key: KEY.PATH=VALUE (repeatable)");
   run_cmd->add_option("--seed", run_seed, "Override the scenario seed");
   run_cmd->add_flag("--force", run_force, "Replace an existing output folder");
@@ -215,15 +216,9 @@ int main(int argc, char** argv) {
   eval_cmd->add_option("--out", ev.out, "Output folder (written atomically)")->required();
   eval_cmd->add_flag("--force", ev.force, "Replace an existing output folder");
 
-  auto* sweep_cmd = app.add_subcommand("sweep", "Plan, run and merge scenario sweeps");
-  std::vector<std::string> sweep_args;
-  sweep_cmd->add_option("ARGS", sweep_args, "plan | run | status | merge | slurm-script ...");
-
-  auto* regress_cmd =
-      app.add_subcommand("regress", "Compare metrics with a baseline (CI regression gate)");
-  std::string regress_baseline, regress_results;
-  regress_cmd->add_option("--baseline", regress_baseline, "Baseline JSON")->required();
-  regress_cmd->add_option("--results", regress_results, "Run or sweep folder")->required();
+  // sweep plan|run|status|merge|slurm-script, regress, and run --manifest/--job/--shard.
+  driftlab::app::SweepCommands sweep_commands(app);
+  sweep_commands.add_run_options(run_cmd, run_scenario_opt, run_out_opt, &run_force);
 
   try {
     app.parse(argc, argv);
@@ -234,6 +229,7 @@ int main(int argc, char** argv) {
   try {
     if (check_cmd->parsed()) return scenario_check(check_file, check_sets, check_quiet);
     if (schema_cmd->parsed()) return scenario_schema(schema_out);
+    if (const auto rc = sweep_commands.dispatch()) return *rc;
     if (run_cmd->parsed()) return run_command(run_file, run_out, run_sets, run_seed, run_force, run_only_motion);
     if (render_cmd->parsed()) {
       const auto scenario = driftlab::pipeline::load_scenario(render_file, render_sets);
@@ -246,9 +242,6 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (eval_cmd->parsed()) return eval_command(ev);
-    if (sweep_cmd->parsed()) throw Unavailable("sweeps arrive with the sweep issue (#9)");
-    if (regress_cmd->parsed())
-      throw Unavailable("the regression gate arrives with the sweep issue (#9)");
   } catch (const Unavailable& e) {
     std::cerr << "driftlab: not available in this build yet: " << e.what() << "\n";
     return kExitUnavailable;

@@ -1,11 +1,7 @@
 #include "pipeline/report.hpp"
 
-#include <fcntl.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <array>
-#include <cerrno>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -13,9 +9,11 @@
 #include <fmt/format.h>
 
 #include "core/atomic_file.hpp"
+#include "core/error.hpp"
 #include "core/rotation.hpp"
 #include "core/time.hpp"
 #include "core/yaml_io.hpp"
+#include "pipeline/process.hpp"
 
 namespace driftlab::pipeline {
 
@@ -78,28 +76,19 @@ std::string html_escape(const std::string& s) {
 
 int run_program(const std::vector<std::string>& argv, const std::filesystem::path& cwd,
                 const std::filesystem::path& log) {
-  std::vector<char*> args;
-  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    if (chdir(cwd.c_str()) != 0) _exit(127);
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) {
-      dup2(fd, 1);
-      dup2(fd, 2);
-      close(fd);
-    }
-    execvp(args[0], args.data());
-    _exit(127);
+  const auto exe = find_on_path(argv.at(0));
+  if (!exe) return -1;
+  ProcessSpec spec;
+  spec.executable = *exe;
+  spec.args.assign(argv.begin() + 1, argv.end());
+  spec.output_file = log;
+  spec.working_directory = cwd;
+  try {
+    const ExitStatus st = wait_process(spawn_process(spec));
+    return st.exited ? st.code : -1;
+  } catch (const UserError&) {
+    return -1;
   }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return -1;
-  }
-  if (!WIFEXITED(status)) return -1;
-  return WEXITSTATUS(status) == 127 ? -1 : WEXITSTATUS(status);
 }
 
 std::vector<PlotFile> make_plots(const std::filesystem::path& dir, const Trajectory& gt,

@@ -221,11 +221,18 @@ TEST(Cli, HelpForEverySubcommand) {
   EXPECT_NE(run_cli({}).exit_code, 0);
 }
 
-TEST(Cli, LaterStagesSaySoClearly) {
+TEST(Cli, ASweepPlanOfAScenarioFileSaysWhatASweepNeeds) {
+  // A scenario is not a sweep: its keys are unknown to the sweep file and it has no base.
+  const fs::path dir = fresh_temp_dir("sweep_of_scenario");
   const std::string file = (kSource / "scenarios/river_crossing.yaml").string();
-  const Result r = run_cli({"sweep", "plan", file});
-  EXPECT_EQ(r.exit_code, 3);
-  EXPECT_NE(r.output.find("not available in this build yet"), std::string::npos) << r.output;
+  const Result r = run_cli({"sweep", "plan", file, "--out", (dir / "out").string()});
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.err.find(file + ": base: missing, expected the path of the base scenario"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(file + ":13:1: scene: unknown key"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -1,0 +1,63 @@
+// The command line of sweeps and of the regression gate: `driftlab sweep ...`,
+// `driftlab regress`, and the `--manifest/--job/--shard` options of `driftlab run`.
+// Kept apart from main.cpp, which only wires these in.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace driftlab::app {
+
+class SweepCommands {
+ public:
+  /// Adds `sweep` (plan, run, status, merge, slurm-script) and `regress` to `app`.
+  explicit SweepCommands(CLI::App& app);
+
+  /// Adds --manifest, --job, --shard and --parallel to the `run` subcommand,
+  /// whose SCENARIO and --out are then required only without --manifest.
+  /// `force` is the run's --force flag (it also reruns a finished job).
+  void add_run_options(CLI::App* run_cmd, CLI::Option* scenario, CLI::Option* out,
+                       const bool* force);
+
+  /// Runs the parsed command if it is one of these; nullopt otherwise.
+  /// Throws as the library does (UserError: bad input).
+  std::optional<int> dispatch();
+
+ private:
+  int plan();
+  int run_local();
+  int status();
+  int merge();
+  int slurm_script();
+  int regress();
+  int run_manifest();
+
+  CLI::App* sweep_ = nullptr;
+  CLI::App* plan_ = nullptr;
+  CLI::App* run_ = nullptr;
+  CLI::App* status_ = nullptr;
+  CLI::App* merge_ = nullptr;
+  CLI::App* slurm_ = nullptr;
+  CLI::App* regress_ = nullptr;
+  CLI::App* run_cmd_ = nullptr;
+
+  std::string sweep_file_, dir_, out_;
+  bool force_ = false;
+  std::size_t parallel_ = 1;
+  std::vector<std::string> covariates_;
+  std::string response_ = "p_m_per_m";
+  bool allow_missing_ = false, no_plots_ = false;
+  std::string partition_, time_, driftlab_;
+  std::size_t cpus_per_task_ = 1, max_parallel_ = 0, shards_ = 0;
+  std::string baseline_, results_, junit_;
+  bool update_ = false;
+  std::string manifest_, job_, shard_;
+  std::size_t run_parallel_ = 1;
+  const bool* run_force_ = nullptr;
+};
+
+}  // namespace driftlab::app

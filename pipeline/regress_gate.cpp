@@ -1,0 +1,437 @@
+#include "pipeline/regress_gate.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/yaml_io.hpp"
+
+namespace driftlab::pipeline {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string where_of(const std::string& label, const YAML::Node& node) {
+  const YAML::Mark m = node.Mark();
+  if (m.is_null()) return label;
+  return fmt::format("{}:{}:{}", label, m.line + 1, m.column + 1);
+}
+
+std::string g(double v) { return fmt::format("{:.6g}", v); }
+
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        // XML 1.0 forbids most control characters, even escaped.
+        if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t' && c != '\r')
+          out += '?';
+        else
+          out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+double BaselineMetric::tolerance() const {
+  return std::max(abs_tol, baseline ? rel_tol * std::abs(*baseline) : 0.0);
+}
+
+Baseline load_baseline(const fs::path& file) {
+  const std::string label = file.string();
+  const YAML::Node root = yaml::load_file(label);
+  yaml::ErrorList errors;
+  Baseline b;
+  b.file = file;
+  auto fail = [&](const YAML::Node& n, const std::string& path, const std::string& got,
+                  const std::string& expected) {
+    errors.add(fmt::format("{}: {}: got {}, expected {}", where_of(label, n), path, got, expected));
+  };
+  auto unknown_keys = [&](const YAML::Node& map, const std::string& prefix,
+                          const std::vector<std::string>& known) {
+    std::set<std::string> seen;
+    for (auto it = map.begin(); it != map.end(); ++it) {
+      const std::string k = it->first.IsScalar() ? it->first.Scalar() : "";
+      const std::string path = prefix.empty() ? k : prefix + "." + k;
+      if (!seen.insert(k).second) {
+        errors.add(fmt::format("{}: {}: duplicate key, expected each key once",
+                               where_of(label, it->first), path));
+        continue;
+      }
+      if (std::find(known.begin(), known.end(), k) != known.end()) continue;
+      std::string hint, list;
+      std::size_t best = 3;
+      for (const auto& kk : known) {
+        const std::size_t d = yaml::edit_distance(k, kk);
+        if (d < best) {
+          best = d;
+          hint = kk;
+        }
+        list += (list.empty() ? "" : ", ") + kk;
+      }
+      errors.add(fmt::format("{}: {}: unknown key{}; expected one of: {}",
+                             where_of(label, it->first), path,
+                             hint.empty() ? "" : " (did you mean '" + hint + "'?)", list));
+    }
+  };
+  if (!root.IsMap()) {
+    errors.add(fmt::format("{}: got {}, expected a JSON object with a \"metrics\" list", label,
+                           yaml::describe_node(root)));
+    errors.throw_if_any();
+  }
+  unknown_keys(root, "", {"description", "metrics"});
+  if (const YAML::Node d = root["description"]; d) {
+    if (d.IsScalar())
+      b.description = d.Scalar();
+    else
+      fail(d, "description", yaml::describe_node(d), "a string");
+  }
+  const YAML::Node metrics = root["metrics"];
+  if (!metrics) {
+    errors.add(
+        fmt::format("{}: metrics: missing, expected a list of {{\"key\": ..., "
+                    "\"baseline\": ..., \"direction\": ..., \"abs_tol\": ..., "
+                    "\"rel_tol\": ...}}",
+                    label));
+  } else if (!metrics.IsSequence() || metrics.size() == 0) {
+    fail(metrics, "metrics", metrics.IsSequence() ? "an empty list" : yaml::describe_node(metrics),
+         "a list of at least one metric");
+  } else {
+    std::set<std::string> keys;
+    for (std::size_t i = 0; i < metrics.size(); ++i) {
+      const YAML::Node e = metrics[i];
+      const std::string path = fmt::format("metrics[{}]", i);
+      if (!e.IsMap()) {
+        fail(e, path, yaml::describe_node(e), "an object {\"key\": ..., \"baseline\": ...}");
+        continue;
+      }
+      unknown_keys(e, path, {"key", "baseline", "direction", "abs_tol", "rel_tol"});
+      BaselineMetric m;
+      m.where = where_of(label, e);
+      const YAML::Node key = e["key"];
+      if (!key) {
+        errors.add(
+            fmt::format("{}: {}.key: missing, expected a metrics.json key path such as "
+                        "algorithms.sparse.ape.trans_m.rmse",
+                        m.where, path));
+      } else if (!key.IsScalar() || key.Scalar().empty()) {
+        fail(key, path + ".key", yaml::describe_node(key), "a metrics.json key path");
+      } else {
+        m.key = key.Scalar();
+        if (!keys.insert(m.key).second)
+          fail(key, path + ".key", "'" + m.key + "' again", "each key once");
+      }
+      auto number = [&](const char* name, bool non_negative) -> std::optional<double> {
+        const YAML::Node n = e[name];
+        if (!n || n.IsNull()) return std::nullopt;
+        double v = 0;
+        if (!n.IsScalar() || !yaml::parse_double(n.Scalar(), &v) || !std::isfinite(v)) {
+          fail(n, path + "." + name, yaml::describe_node(n), "a finite number");
+          return std::nullopt;
+        }
+        if (non_negative && v < 0) {
+          fail(n, path + "." + name, yaml::describe_node(n), "a number >= 0");
+          return std::nullopt;
+        }
+        return v;
+      };
+      m.baseline = number("baseline", false);
+      m.abs_tol = number("abs_tol", true).value_or(0.0);
+      m.rel_tol = number("rel_tol", true).value_or(0.0);
+      if (const YAML::Node d = e["direction"]; d) {
+        std::optional<MetricDirection> dir;
+        if (d.IsScalar()) dir = yaml::enum_from_name<MetricDirection>(d.Scalar());
+        if (!dir)
+          fail(d, path + ".direction", yaml::describe_node(d),
+               "one of: lower (lower is better), higher (higher is better), both (no change "
+               "beyond the tolerance)");
+        else
+          m.direction = *dir;
+      }
+      b.metrics.push_back(std::move(m));
+    }
+  }
+  errors.throw_if_any();
+  return b;
+}
+
+std::string baseline_json(const Baseline& b) {
+  nlohmann::ordered_json j;
+  if (!b.description.empty()) j["description"] = b.description;
+  j["metrics"] = nlohmann::ordered_json::array();
+  for (const auto& m : b.metrics) {
+    nlohmann::ordered_json e;
+    e["key"] = m.key;
+    e["baseline"] = m.baseline ? nlohmann::ordered_json(*m.baseline) : nlohmann::ordered_json();
+    e["direction"] = std::string(yaml::enum_name(m.direction));
+    e["abs_tol"] = m.abs_tol;
+    e["rel_tol"] = m.rel_tol;
+    j["metrics"].push_back(e);
+  }
+  return j.dump(2) + "\n";
+}
+
+fs::path find_results_metrics(const fs::path& results) {
+  std::error_code ec;
+  if (fs::is_regular_file(results, ec)) return results;
+  if (!fs::exists(results, ec))
+    throw UserError(
+        fmt::format("--results: got '{}', expected an existing run folder, merged "
+                    "sweep folder or metrics.json",
+                    results.string()));
+  if (fs::is_regular_file(results / "metrics.json", ec)) return results / "metrics.json";
+  if (fs::is_regular_file(results / "summary" / "metrics.json", ec))
+    return results / "summary" / "metrics.json";
+  if (fs::exists(results / "manifest.jsonl", ec))
+    throw UserError(
+        fmt::format("--results: got '{}', a sweep folder that is not merged yet, "
+                    "expected DIR/summary/metrics.json: run `driftlab sweep merge {}` "
+                    "first",
+                    results.string(), results.string()));
+  throw UserError(
+      fmt::format("--results: got '{}', expected a run folder (with metrics.json), "
+                  "a merged sweep folder (with summary/metrics.json) or a "
+                  "metrics.json file",
+                  results.string()));
+}
+
+std::optional<double> metric_value(const nlohmann::json& doc, const std::string& key,
+                                   std::string* why) {
+  const nlohmann::json* node = &doc;
+  if (!key.empty() && key[0] == '/') {
+    try {
+      const nlohmann::json::json_pointer ptr(key);
+      if (!doc.contains(ptr)) {
+        *why = "no such key";
+        return std::nullopt;
+      }
+      node = &doc.at(ptr);
+    } catch (const nlohmann::json::exception& e) {
+      *why = std::string("not a valid JSON pointer: ") + e.what();
+      return std::nullopt;
+    }
+  } else {
+    std::size_t start = 0;
+    std::string walked;
+    while (true) {
+      const auto dot = key.find('.', start);
+      const std::string part = key.substr(start, dot == std::string::npos ? dot : dot - start);
+      if (node->is_object() && node->contains(part)) {
+        node = &(*node)[part];
+      } else if (node->is_array() && !part.empty() &&
+                 std::all_of(part.begin(), part.end(),
+                             [](char ch) { return ch >= '0' && ch <= '9'; }) &&
+                 std::stoul(part) < node->size()) {
+        node = &(*node)[std::stoul(part)];
+      } else {
+        *why = walked.empty() ? fmt::format("no '{}' at the top level", part)
+                              : fmt::format("no '{}' under {}", part, walked);
+        return std::nullopt;
+      }
+      walked += (walked.empty() ? "" : ".") + part;
+      if (dot == std::string::npos) break;
+      start = dot + 1;
+    }
+  }
+  if (node->is_null()) {
+    *why = "null (not computed for these results)";
+    return std::nullopt;
+  }
+  if (!node->is_number()) {
+    *why = fmt::format("not a number ({})", node->type_name());
+    return std::nullopt;
+  }
+  return node->get<double>();
+}
+
+GateResult check_baseline(const Baseline& baseline, const nlohmann::json& results,
+                          const fs::path& results_file) {
+  GateResult r;
+  r.baseline_file = baseline.file;
+  r.results_file = results_file;
+  for (const auto& m : baseline.metrics) {
+    MetricCheck c;
+    c.metric = m;
+    c.value = metric_value(results, m.key, &c.note);
+    if (!c.value) {
+      c.verdict = Verdict::kMissing;
+    } else if (!m.baseline) {
+      c.verdict = Verdict::kNoBaseline;
+      c.note = "no baseline value yet (record one with --update)";
+    } else {
+      const double diff = *c.value - *m.baseline;
+      const double tol = m.tolerance();
+      switch (m.direction) {
+        case MetricDirection::kLower:
+          c.verdict = diff > tol    ? Verdict::kRegressed
+                      : diff < -tol ? Verdict::kImproved
+                                    : Verdict::kPass;
+          break;
+        case MetricDirection::kHigher:
+          c.verdict = diff < -tol  ? Verdict::kRegressed
+                      : diff > tol ? Verdict::kImproved
+                                   : Verdict::kPass;
+          break;
+        case MetricDirection::kBoth:
+          c.verdict = std::abs(diff) > tol ? Verdict::kRegressed : Verdict::kPass;
+          break;
+      }
+    }
+    r.checks.push_back(std::move(c));
+  }
+  return r;
+}
+
+std::size_t GateResult::failures() const {
+  return static_cast<std::size_t>(
+      std::count_if(checks.begin(), checks.end(), [](const MetricCheck& c) { return c.failed(); }));
+}
+
+namespace {
+
+std::string change_text(const MetricCheck& c) {
+  if (!c.value || !c.metric.baseline) return "";
+  const double diff = *c.value - *c.metric.baseline;
+  std::string s = fmt::format("{:+.3g}", diff);
+  if (*c.metric.baseline != 0)
+    s += fmt::format(" ({:+.1f}%)", 100.0 * diff / std::abs(*c.metric.baseline));
+  return s;
+}
+
+std::string tolerance_text(const MetricCheck& c) {
+  const char* sign = c.metric.direction == MetricDirection::kLower    ? "+"
+                     : c.metric.direction == MetricDirection::kHigher ? "-"
+                                                                      : "±";
+  return sign + g(c.metric.tolerance());
+}
+
+}  // namespace
+
+std::string GateResult::table() const {
+  std::vector<std::array<std::string, 6>> rows;
+  rows.push_back({"metric", "baseline", "new", "change", "tolerance", "verdict"});
+  for (const auto& c : checks) {
+    std::string verdict(yaml::enum_name(c.verdict));
+    if (c.verdict == Verdict::kMissing) verdict += ": " + c.note;
+    rows.push_back({c.metric.key, c.metric.baseline ? g(*c.metric.baseline) : "—",
+                    c.value ? g(*c.value) : "—", change_text(c), tolerance_text(c), verdict});
+  }
+  std::array<std::size_t, 6> width{};
+  for (const auto& r : rows)
+    for (std::size_t k = 0; k < 5; ++k) width[k] = std::max(width[k], r[k].size());
+  std::string out;
+  for (const auto& r : rows) {
+    std::string line;
+    for (std::size_t k = 0; k < 6; ++k) {
+      const bool left = k == 0 || k == 5;
+      line += k == 5 ? r[k]
+              : left ? fmt::format("{:<{}}  ", r[k], width[k])
+                     : fmt::format("{:>{}}  ", r[k], width[k]);
+    }
+    out += line + "\n";
+  }
+  return out;
+}
+
+std::string GateResult::brief() const {
+  std::size_t counts[5] = {};
+  for (const auto& c : checks) ++counts[static_cast<int>(c.verdict)];
+  std::string s = fmt::format("{} metrics:", checks.size());
+  bool first = true;
+  for (const auto& [v, name] : enum_table(Verdict{})) {
+    const std::size_t n = counts[static_cast<int>(v)];
+    if (n == 0 && v != Verdict::kPass) continue;
+    s += fmt::format("{} {} {}", first ? "" : ",", n, name);
+    first = false;
+  }
+  return s;
+}
+
+std::string GateResult::junit_xml() const {
+  const std::string suite = "driftlab.regress." + baseline_file.stem().string();
+  std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  x += fmt::format(
+      "<testsuites name=\"driftlab regress\" tests=\"{}\" failures=\"{}\" "
+      "errors=\"0\">\n",
+      checks.size(), failures());
+  x += fmt::format(
+      "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"0\" "
+      "skipped=\"0\">\n",
+      xml_escape(suite), checks.size(), failures());
+  x += "    <properties>\n";
+  x += fmt::format("      <property name=\"baseline\" value=\"{}\"/>\n",
+                   xml_escape(baseline_file.string()));
+  x += fmt::format("      <property name=\"results\" value=\"{}\"/>\n",
+                   xml_escape(results_file.string()));
+  x += "    </properties>\n";
+  for (const auto& c : checks) {
+    x += fmt::format("    <testcase classname=\"{}\" name=\"{}\" time=\"0\"", xml_escape(suite),
+                     xml_escape(c.metric.key));
+    if (!c.failed()) {
+      x += "/>\n";
+      continue;
+    }
+    std::string message;
+    if (c.verdict == Verdict::kMissing) {
+      message = "missing from the results: " + c.note;
+    } else if (c.verdict == Verdict::kNoBaseline) {
+      message = c.note;
+    } else {
+      message = fmt::format(
+          "regressed: baseline {}, new {}, change {}, tolerance {} ({} is "
+          "better)",
+          g(*c.metric.baseline), g(*c.value), change_text(c), tolerance_text(c),
+          yaml::enum_name(c.metric.direction));
+    }
+    x += fmt::format(">\n      <failure type=\"{}\" message=\"{}\">{}</failure>\n    </testcase>\n",
+                     xml_escape(std::string(yaml::enum_name(c.verdict))), xml_escape(message),
+                     xml_escape(message));
+  }
+  x += "    <system-out>" + xml_escape(table()) + "</system-out>\n";
+  x += "  </testsuite>\n</testsuites>\n";
+  return x;
+}
+
+Baseline updated_baseline(const Baseline& baseline, const GateResult& result) {
+  Baseline b = baseline;
+  std::string missing;
+  for (std::size_t i = 0; i < b.metrics.size(); ++i) {
+    const MetricCheck& c = result.checks.at(i);
+    if (!c.value) {
+      missing += fmt::format("\n{}: {}: {}", c.metric.where, c.metric.key, c.note);
+      continue;
+    }
+    b.metrics[i].baseline = *c.value;
+  }
+  if (!missing.empty())
+    throw UserError(
+        fmt::format("--update: {} lacks metrics of the baseline, expected every "
+                    "key; nothing was updated:{}",
+                    result.results_file.string(), missing));
+  return b;
+}
+
+}  // namespace driftlab::pipeline

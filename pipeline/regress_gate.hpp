@@ -1,0 +1,109 @@
+// The CI regression gate (`driftlab regress`): compares chosen metrics.json
+// values of a run or of a merged sweep with a committed baseline, each with an
+// absolute / relative tolerance and a direction, and reports old, new, change
+// and a verdict per metric (a table and JUnit XML).
+//
+// Baseline file (JSON; read with line numbers, so errors name the line):
+//   {
+//     "description": "what this gate protects",
+//     "metrics": [
+//       {"key": "algorithms.sparse.runs.ape_trans_rmse_m.mean", "baseline": 0.0123,
+//        "direction": "lower", "abs_tol": 0.001, "rel_tol": 0.1}
+//     ]
+//   }
+// key: a dotted key path into metrics.json, or a JSON pointer ("/a/b.c/0") for
+// keys that hold dots. direction: lower (lower is better: an increase beyond the
+// tolerance is a regression), higher, or both (any change beyond it is).
+// The tolerance is max(abs_tol, rel_tol * |baseline|); both default to 0.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace driftlab::pipeline {
+
+enum class MetricDirection { kLower, kHigher, kBoth };
+constexpr auto enum_table(MetricDirection) {
+  return std::array{std::pair{MetricDirection::kLower, "lower"},
+                    std::pair{MetricDirection::kHigher, "higher"},
+                    std::pair{MetricDirection::kBoth, "both"}};
+}
+
+struct BaselineMetric {
+  std::string key;
+  std::optional<double> baseline;  // absent: not yet recorded (run with --update)
+  MetricDirection direction = MetricDirection::kLower;
+  double abs_tol = 0;
+  double rel_tol = 0;
+  std::string where;  // FILE:LINE:COL of the entry
+  double tolerance() const;
+};
+
+struct Baseline {
+  std::filesystem::path file;
+  std::string description;
+  std::vector<BaselineMetric> metrics;
+};
+
+/// Reads a baseline file. Throws UserError naming file, line, field, value and
+/// what was expected (unknown keys, wrong types, negative tolerances, an empty
+/// metrics list, duplicate keys).
+Baseline load_baseline(const std::filesystem::path& file);
+
+/// The baseline as JSON text (what --update writes).
+std::string baseline_json(const Baseline& b);
+
+enum class Verdict { kPass, kImproved, kRegressed, kMissing, kNoBaseline };
+constexpr auto enum_table(Verdict) {
+  return std::array{std::pair{Verdict::kPass, "pass"}, std::pair{Verdict::kImproved, "improved"},
+                    std::pair{Verdict::kRegressed, "REGRESSED"},
+                    std::pair{Verdict::kMissing, "MISSING"},
+                    std::pair{Verdict::kNoBaseline, "NO BASELINE"}};
+}
+
+struct MetricCheck {
+  BaselineMetric metric;
+  std::optional<double> value;  // the new value
+  Verdict verdict = Verdict::kPass;
+  std::string note;  // why MISSING
+  bool failed() const {
+    return verdict == Verdict::kRegressed || verdict == Verdict::kMissing ||
+           verdict == Verdict::kNoBaseline;
+  }
+};
+
+struct GateResult {
+  std::filesystem::path baseline_file;
+  std::filesystem::path results_file;  // the metrics.json compared
+  std::vector<MetricCheck> checks;
+  std::size_t failures() const;
+  /// metric | baseline | new | change | tolerance | verdict, aligned.
+  std::string table() const;
+  /// "5 metrics: 3 pass, 1 improved, 1 REGRESSED".
+  std::string brief() const;
+  /// JUnit XML: one test case per metric, a <failure> for each failed one.
+  std::string junit_xml() const;
+};
+
+/// The metrics.json that `results` stands for: the file itself, DIR/metrics.json
+/// (a run), or DIR/summary/metrics.json (a merged sweep). Throws UserError
+/// otherwise (a sweep folder not yet merged is named as such).
+std::filesystem::path find_results_metrics(const std::filesystem::path& results);
+
+/// The value at a dotted key path or JSON pointer; nullopt with `why` when
+/// absent, null or not a number.
+std::optional<double> metric_value(const nlohmann::json& doc, const std::string& key,
+                                   std::string* why);
+
+GateResult check_baseline(const Baseline& baseline, const nlohmann::json& results,
+                          const std::filesystem::path& results_file);
+
+/// The baseline with every value replaced by the new one. Throws UserError
+/// naming the metrics the results lack (nothing is updated then).
+Baseline updated_baseline(const Baseline& baseline, const GateResult& result);
+
+}  // namespace driftlab::pipeline

@@ -1,0 +1,71 @@
+// `driftlab sweep merge`: pools the sections of every run of a sweep folder
+// into one table (each run's swept parameters as extra covariate columns),
+// fits river paper Eq. (13) by OLS on the pool, summarises every design point
+// over its replicates (mean and 95% confidence interval) and plots the error
+// against each swept parameter. Writes DIR/summary/:
+//   sections.csv   every section of every run: job, point, replicate, seed,
+//                  one column per axis, then the run's sections.csv columns
+//   runs.csv       one row per run and algorithm: parameters and run metrics
+//   points.csv     one row per point and algorithm: mean, SD, 95% CI per metric
+//   metrics.json   the pool per algorithm (section errors, regression, run
+//                  metrics over all runs) and every point; `driftlab regress` reads it
+//   summary.md     the same for people, with the plots
+//   plots/         AXIS__METRIC.png (gnuplot), with the .dat and .gp that made them
+// Rows, columns and numbers depend only on the runs' outputs and the manifest
+// order, never on which job finished first: the same sweep merges to the same bytes.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "pipeline/sweep.hpp"
+
+namespace driftlab::pipeline {
+
+struct MergeOptions {
+  /// Regression covariates: columns of the pooled table (section covariates
+  /// such as v, h, f, d, or axis names). Empty: the base scenario's
+  /// eval.regression_covariates that the pool has, plus every numeric axis
+  /// that varies.
+  std::vector<std::string> covariates;
+  /// The regression's response: a column of the pooled table.
+  std::string response = "p_m_per_m";
+  /// Merge the finished jobs even when some are not done.
+  bool allow_missing = false;
+  /// Make PNG plots with gnuplot (skipped, with a warning, when not installed).
+  bool plots = true;
+  /// gnuplot to use; empty: `gnuplot` on PATH.
+  std::filesystem::path gnuplot;
+};
+
+struct MergeSummary {
+  std::filesystem::path dir;  // DIR/summary
+  std::size_t runs = 0;       // merged (done) runs
+  std::size_t sections = 0;   // pooled rows
+  std::vector<std::string> algorithms;
+  std::vector<std::string> plots;     // PNG files written (relative to dir)
+  std::vector<std::string> warnings;  // skipped plots, regressions not fitted, ...
+  std::string brief() const;
+};
+
+/// Merges the sweep folder into DIR/summary (written aside, renamed into
+/// place). Throws UserError, writing nothing, when jobs are not done (unless
+/// allow_missing) or a requested covariate or response is not a column.
+MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& options = {});
+
+/// The run metrics that points.csv and runs.csv summarise: name and the key
+/// path under algorithms.ALGO of a run's metrics.json.
+struct RunMetric {
+  const char* name;
+  const char* path;
+  const char* label;  // axis label of plots
+};
+const std::vector<RunMetric>& run_metrics();
+
+/// Two-sided 95% confidence interval of a mean from n samples with sample
+/// standard deviation sd (Student's t with n - 1 degrees of freedom);
+/// {mean, mean} when n < 2.
+std::pair<double, double> confidence_interval_95(double mean, double sd, std::size_t n);
+
+}  // namespace driftlab::pipeline

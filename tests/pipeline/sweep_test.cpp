@@ -1,0 +1,686 @@
+// Sweeps: the sweep file, its expansion into jobs (grid, zip, Latin hypercube),
+// seeds and parameter hashes, bad sweep files, job states and Slurm shards; and,
+// through the real `driftlab` binary, that a sweep merges to the same bytes
+// whether run with -j 2, as shards, or killed and resumed.
+#include "pipeline/sweep.hpp"
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "core/error.hpp"
+#include "core/rng.hpp"
+#include "core/yaml_io.hpp"
+#include "pipeline/process.hpp"
+#include "pipeline/regress_gate.hpp"
+#include "pipeline/scenario.hpp"
+#include "pipeline/sweep_merge.hpp"
+#include "pipeline/sweep_runner.hpp"
+
+namespace driftlab::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kSource = DRIFTLAB_SOURCE_DIR;
+const fs::path kCli = fs::path(DRIFTLAB_BINARY_DIR) / "bin" / "driftlab";
+const fs::path kSweeps = kSource / "tests/data/sweeps";
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d =
+      fs::temp_directory_path() / ("driftlab_sweep_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  return d;
+}
+
+// A sweep from text, in the folder of the test sweeps (so that `base: tiny_base.yaml` resolves).
+Sweep sweep_from(const std::string& text) {
+  return parse_sweep(text, (kSweeps / "inline.yaml").string(), kSweeps);
+}
+
+std::string param(const SweepJob& j, const std::string& name) {
+  for (const auto& [n, v] : j.params)
+    if (n == name) return v;
+  return "(none)";
+}
+
+double number(const std::string& s) {
+  double v = 0;
+  EXPECT_TRUE(yaml::parse_double(s, &v)) << s;
+  return v;
+}
+
+// ---------------------------------------------------------------------------
+// Expansion
+
+TEST(SweepPlan, GridIsRowMajorWithReplicatesInnermost) {
+  const SweepPlan plan = plan_sweep(sweep_from(R"(
+base: tiny_base.yaml
+replicates: 2
+axes:
+  - key: mission.yaw_weave.amplitude_deg
+    name: amp
+    values: [0, 10]
+  - key: mission.yaw_weave.period_s
+    range: {start: 5, stop: 8, step: 1}
+)"));
+  ASSERT_EQ(plan.points, 6u);
+  ASSERT_EQ(plan.jobs.size(), 12u);
+  const std::vector<std::pair<std::string, std::string>> expected = {
+      {"0", "5"}, {"0", "6"}, {"0", "7"}, {"10", "5"}, {"10", "6"}, {"10", "7"}};
+  for (std::size_t k = 0; k < plan.jobs.size(); ++k) {
+    const SweepJob& j = plan.jobs[k];
+    EXPECT_EQ(j.index, k);
+    EXPECT_EQ(j.point, k / 2);
+    EXPECT_EQ(j.replicate, k % 2);
+    EXPECT_EQ(j.id, (k / 2 < 10 ? "p000" : "p00") + std::to_string(k / 2) + "-r0" +
+                        std::to_string(k % 2));
+    EXPECT_EQ(param(j, "amp"), expected[k / 2].first);
+    EXPECT_EQ(param(j, "mission.yaw_weave.period_s"), expected[k / 2].second);
+    ASSERT_EQ(j.overrides.size(), 3u);
+    EXPECT_EQ(j.overrides[0], "mission.yaw_weave.amplitude_deg=" + expected[k / 2].first);
+    EXPECT_EQ(j.overrides[1], "mission.yaw_weave.period_s=" + expected[k / 2].second);
+    EXPECT_EQ(j.overrides[2], "seed=" + std::to_string(j.seed));
+  }
+}
+
+TEST(SweepPlan, ZipPairsTheKthValues) {
+  const SweepPlan plan = plan_sweep(sweep_from(R"(
+base: tiny_base.yaml
+design: zip
+set:
+  water.waves.model: airy
+  water.waves.water_depth_m: 0.6
+axes:
+  - key: water.waves.airy.amplitude_m
+    values: [0.005, 0.0075, 0.011]
+  - key: water.waves.airy.wavelength_m
+    values: [0.21, 0.132, 0.059]
+)"));
+  ASSERT_EQ(plan.jobs.size(), 3u);
+  EXPECT_EQ(param(plan.jobs[1], "water.waves.airy.amplitude_m"), "0.0075");
+  EXPECT_EQ(param(plan.jobs[1], "water.waves.airy.wavelength_m"), "0.132");
+  EXPECT_EQ(param(plan.jobs[2], "water.waves.airy.wavelength_m"), "0.059");
+  // The fixed overrides are part of the base scenario of every job.
+  const Scenario sc = parse_scenario(plan.scenario_yaml, "scenario.yaml", kSweeps);
+  EXPECT_EQ(sc.water.waves.model, sim::WaveModel::kAiry);
+  EXPECT_EQ(sc.water.waves.water_depth_m, 0.6);
+}
+
+TEST(SweepPlan, RangeLinspaceAndLogspaceValues) {
+  const Sweep s = sweep_from(R"(
+base: tiny_base.yaml
+axes:
+  - key: mission.yaw_weave.period_s
+    range: {start: 0.1, stop: 0.4, step: 0.1}
+  - key: mission.yaw_weave.amplitude_deg
+    linspace: {start: 0, stop: 1, num: 5}
+  - key: water.waves.airy.amplitude_m
+    logspace: {start: 0.001, stop: 0.1, num: 3}
+  - key: scene.river_reach.buildings
+    range: {start: 6, stop: 0, step: -2}
+)");
+  // Python's range: stop excluded; generated values rounded to 12 significant digits.
+  EXPECT_EQ(s.axes[0].levels, (std::vector<std::string>{"0.1", "0.2", "0.3"}));
+  EXPECT_EQ(s.axes[1].levels, (std::vector<std::string>{"0", "0.25", "0.5", "0.75", "1"}));
+  // logspace: start and stop are the values themselves (as numpy.geomspace).
+  EXPECT_EQ(s.axes[2].levels, (std::vector<std::string>{"0.001", "0.01", "0.1"}));
+  EXPECT_EQ(s.axes[3].levels, (std::vector<std::string>{"6", "4", "2"}));
+  for (const auto& a : s.axes) EXPECT_TRUE(a.numeric);
+}
+
+TEST(SweepPlan, LatinHypercubeUsesEveryStratumOnce) {
+  const std::string text = R"(
+base: tiny_base.yaml
+design: random
+samples: 8
+seed: 3
+axes:
+  - key: mission.yaw_weave.amplitude_deg
+    linspace: {start: 0, stop: 40}
+  - key: water.waves.airy.amplitude_m
+    logspace: {start: 0.001, stop: 0.256}
+  - key: scene.river_reach.buildings
+    values: [1, 2, 3, 4]
+)";
+  const SweepPlan plan = plan_sweep(sweep_from(text));
+  ASSERT_EQ(plan.jobs.size(), 8u);
+  std::set<int> lin_strata, log_strata;
+  std::map<std::string, int> level_count;
+  for (const auto& j : plan.jobs) {
+    const double a = number(param(j, "mission.yaw_weave.amplitude_deg"));
+    const double w = number(param(j, "water.waves.airy.amplitude_m"));
+    ASSERT_GE(a, 0);
+    ASSERT_LE(a, 40);
+    ASSERT_GE(w, 0.001);
+    ASSERT_LE(w, 0.256);
+    lin_strata.insert(static_cast<int>(std::floor(a / 5.0)));  // 40 / 8 = 5 per stratum
+    // log2(0.256 / 0.001) = 8: one octave per stratum.
+    log_strata.insert(static_cast<int>(std::floor(std::log2(w / 0.001) + 1e-9)));
+    ++level_count[param(j, "scene.river_reach.buildings")];
+  }
+  EXPECT_EQ(lin_strata, (std::set<int>{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_EQ(log_strata, (std::set<int>{0, 1, 2, 3, 4, 5, 6, 7}));
+  // 8 strata over 4 levels: each level twice.
+  EXPECT_EQ(level_count, (std::map<std::string, int>{{"1", 2}, {"2", 2}, {"3", 2}, {"4", 2}}));
+
+  // Seeded: the same file gives the same points, another seed others.
+  const SweepPlan again = plan_sweep(sweep_from(text));
+  EXPECT_EQ(again.manifest_jsonl(), plan.manifest_jsonl());
+  std::string other = text;
+  other.replace(other.find("seed: 3"), 7, "seed: 4");
+  EXPECT_NE(plan_sweep(sweep_from(other)).manifest_jsonl(), plan.manifest_jsonl());
+}
+
+// ---------------------------------------------------------------------------
+// Seeds and hashes
+
+TEST(SweepPlan, ReplicateSeedsAreDistinctCommonToPointsAndDerivedFromTheSweepSeed) {
+  const SweepPlan plan = plan_sweep(sweep_from(R"(
+base: tiny_base.yaml
+replicates: 3
+seed: 42
+axes:
+  - key: mission.yaw_weave.amplitude_deg
+    values: [0, 10]
+)"));
+  ASSERT_EQ(plan.jobs.size(), 6u);
+  std::set<std::uint64_t> seeds;
+  for (const auto& j : plan.jobs) {
+    // The documented derivation: the low 53 bits of derive_seed(seed, "sweep.replicate.<r>").
+    const std::uint64_t expected =
+        derive_seed(42, "sweep.replicate." + std::to_string(j.replicate)) & ((1ULL << 53) - 1);
+    EXPECT_EQ(j.seed, expected) << j.id;
+    EXPECT_LT(j.seed, 1ULL << 53);
+    seeds.insert(j.seed);
+  }
+  EXPECT_EQ(seeds.size(), 3u);  // distinct per replicate, the same at both points
+  EXPECT_EQ(plan.jobs[0].seed, plan.jobs[3].seed);
+
+  // Without a seed key, the sweep seed is the base scenario's (tiny_base.yaml: seed 7).
+  const SweepPlan defaulted = plan_sweep(sweep_from(R"(
+base: tiny_base.yaml
+axes:
+  - key: mission.yaw_weave.amplitude_deg
+    values: [0]
+)"));
+  EXPECT_EQ(defaulted.seed, 7u);
+  EXPECT_EQ(defaulted.jobs[0].seed, derive_seed(7, "sweep.replicate.0") & ((1ULL << 53) - 1));
+}
+
+TEST(SweepPlan, Fnv1aMatchesPublishedVectors) {
+  // Test vectors of the FNV-1a 64-bit hash (Fowler, Noll, Vo reference test suite).
+  EXPECT_EQ(fnv1a64_hex(""), "cbf29ce484222325");
+  EXPECT_EQ(fnv1a64_hex("a"), "af63dc4c8601ec8c");
+  EXPECT_EQ(fnv1a64_hex("foobar"), "85944171f73967e8");
+}
+
+TEST(SweepPlan, HashIsThatOfTheResolvedScenarioAndStable) {
+  const std::string text = R"(
+base: tiny_base.yaml
+replicates: 2
+axes:
+  - key: mission.yaw_weave.amplitude_deg
+    values: [0, 10]
+)";
+  const SweepPlan a = plan_sweep(sweep_from(text));
+  const SweepPlan b = plan_sweep(sweep_from(text));
+  std::set<std::string> hashes;
+  for (std::size_t k = 0; k < a.jobs.size(); ++k) {
+    EXPECT_EQ(a.jobs[k].hash, b.jobs[k].hash);
+    EXPECT_EQ(a.jobs[k].hash.size(), 16u);
+    hashes.insert(a.jobs[k].hash);
+    // What the hash covers: every parameter of the job's resolved scenario.
+    const Scenario sc = parse_scenario(a.scenario_yaml, "x", kSweeps, a.jobs[k].overrides);
+    EXPECT_EQ(a.jobs[k].hash, fnv1a64_hex(yaml::to_yaml(sc, false)));
+  }
+  EXPECT_EQ(hashes.size(), 4u);  // parameters or seed differ in every pair of jobs
+  // A change to the base (here a fixed override) changes every hash.
+  std::string with_set = text;
+  with_set += "set:\n  pipeline.max_frames: 9\n";
+  const SweepPlan c = plan_sweep(sweep_from(with_set));
+  for (std::size_t k = 0; k < a.jobs.size(); ++k) EXPECT_NE(c.jobs[k].hash, a.jobs[k].hash);
+}
+
+// ---------------------------------------------------------------------------
+// Bad sweep files: each states, in "# expect:" lines, what its message must contain.
+
+std::vector<fs::path> bad_sweeps() {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(kSource / "tests/data/bad_sweeps"))
+    if (e.path().extension() == ".yaml") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::vector<std::string> expectations(const fs::path& file) {
+  std::vector<std::string> out;
+  std::ifstream in(file);
+  std::string line;
+  const std::string tag = "# expect: ";
+  while (std::getline(in, line))
+    if (line.rfind(tag, 0) == 0) out.push_back(line.substr(tag.size()));
+  return out;
+}
+
+TEST(BadSweeps, CoverTheIssuesCases) {
+  std::set<std::string> names;
+  for (const auto& f : bad_sweeps()) names.insert(f.stem().string());
+  for (const char* n : {"unknown_key_path", "empty_axis", "replicates_zero", "samples_with_grid",
+                        "random_without_samples", "zip_lengths_differ", "two_value_specs"})
+    EXPECT_TRUE(names.count(n)) << n;
+}
+
+class BadSweep : public ::testing::TestWithParam<fs::path> {};
+
+TEST_P(BadSweep, FailsWithItsOwnClearMessage) {
+  const fs::path file = GetParam();
+  const auto expected = expectations(file);
+  ASSERT_FALSE(expected.empty()) << file << " has no '# expect:' line";
+  try {
+    plan_sweep(load_sweep(file));
+    FAIL() << file << " was accepted";
+  } catch (const UserError& e) {
+    const std::string what = e.what();
+    for (const auto& x : expected) EXPECT_NE(what.find(x), std::string::npos) << what;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(All, BadSweep, ::testing::ValuesIn(bad_sweeps()),
+                         [](const ::testing::TestParamInfo<fs::path>& info) {
+                           return info.param.stem().string();
+                         });
+
+TEST(BadSweeps, EveryProblemIsReportedAtOnce) {
+  try {
+    sweep_from(R"(
+base: tiny_base.yaml
+replicates: 0
+axes:
+  - key: a.b
+    values: []
+)");
+    FAIL();
+  } catch (const UserError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("inline.yaml:3:13: replicates: got '0', expected an integer >= 1"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("inline.yaml:6:13: axes[0].values: got an empty list, expected at least "
+                        "one value"),
+              std::string::npos)
+        << what;
+  }
+}
+
+// ---------------------------------------------------------------------------
+// The sweep folder: manifest, states, shards, Slurm
+
+TEST(SweepFolder, ManifestReadsBackAsPlanned) {
+  const fs::path dir = temp_dir("manifest");
+  const SweepPlan plan = plan_sweep(load_sweep(kSweeps / "tiny_grid.yaml"));
+  const auto w = write_plan(plan, dir, false);
+  EXPECT_FALSE(w.unchanged);
+  const SweepManifest m = read_manifest(dir / "manifest.jsonl");
+  ASSERT_EQ(m.jobs.size(), plan.jobs.size());
+  for (std::size_t k = 0; k < m.jobs.size(); ++k) {
+    EXPECT_EQ(m.jobs[k].id, plan.jobs[k].id);
+    EXPECT_EQ(m.jobs[k].seed, plan.jobs[k].seed);
+    EXPECT_EQ(m.jobs[k].overrides, plan.jobs[k].overrides);
+    EXPECT_EQ(m.jobs[k].params, plan.jobs[k].params);
+    EXPECT_EQ(m.jobs[k].hash, plan.jobs[k].hash);
+  }
+  ASSERT_EQ(m.axes.size(), 1u);
+  EXPECT_EQ(m.axes[0].name, "yaw_amp_deg");
+  EXPECT_EQ(slurp(dir / "scenario.yaml"), plan.scenario_yaml);
+  // One job per line, as JSON.
+  const std::string first =
+      slurp(dir / "manifest.jsonl").substr(0, slurp(dir / "manifest.jsonl").find('\n'));
+  const auto j = nlohmann::json::parse(first);
+  EXPECT_EQ(j["id"], "p0000-r00");
+  EXPECT_EQ(j["params"]["yaw_amp_deg"], 0);
+  // Planning again: the same plan is left alone; a different one needs --force.
+  EXPECT_TRUE(write_plan(plan, dir, false).unchanged);
+  SweepPlan other = plan;
+  other.jobs.pop_back();
+  EXPECT_THROW(write_plan(other, dir, false), UserError);
+  EXPECT_TRUE(write_plan(other, dir, true).replaced);
+  EXPECT_EQ(read_manifest(dir).jobs.size(), plan.jobs.size() - 1);
+  fs::remove_all(dir);
+}
+
+TEST(SweepFolder, JobStatesAndTheResubmissionLine) {
+  const fs::path dir = temp_dir("states");
+  const SweepPlan plan = plan_sweep(load_sweep(kSweeps / "tiny_grid.yaml"));
+  write_plan(plan, dir, false);
+  const SweepManifest m = read_manifest(dir);
+  // p0000-r00 done, p0000-r01 stale (another hash), p0001-r00 failed, p0001-r01 missing.
+  fs::create_directories(m.run_dir("p0000-r00"));
+  std::ofstream(m.marker("p0000-r00")) << nlohmann::json{{"hash", m.jobs[0].hash}}.dump();
+  fs::create_directories(m.run_dir("p0000-r01"));
+  std::ofstream(m.marker("p0000-r01")) << nlohmann::json{{"hash", "0000000000000000"}}.dump();
+  fs::create_directories(dir / "failed");
+  std::ofstream(m.failed_record("p0001-r00"))
+      << nlohmann::json{{"status", "exit code 1"}, {"error", "boom\nmore"}}.dump();
+  const SweepStatus st = sweep_status(m);
+  ASSERT_EQ(st.jobs.size(), 4u);
+  EXPECT_EQ(st.jobs[0].state, JobState::kDone);
+  EXPECT_EQ(st.jobs[1].state, JobState::kStale);
+  EXPECT_EQ(st.jobs[2].state, JobState::kFailed);
+  EXPECT_EQ(st.jobs[2].detail, "exit code 1: boom");
+  EXPECT_EQ(st.jobs[3].state, JobState::kMissing);
+  EXPECT_EQ(st.brief(), "4 jobs: 1 done, 1 failed, 1 stale, 1 missing");
+  EXPECT_FALSE(st.complete());
+
+  // Shards of 3: job k in shard k % 3; jobs 1, 2 and 3 are unfinished: shards 1, 2, 0.
+  SlurmOptions so;
+  so.executable = kCli;
+  so.shards = 3;
+  so.max_parallel = 2;
+  const SlurmScript script = write_slurm_script(m, so);
+  EXPECT_EQ(resubmit_command(m, st, script),
+            "sbatch --array=0-2%2 '" + (dir / "slurm/sweep.sbatch").string() + "'");
+  const std::string text = slurp(script.script);
+  EXPECT_NE(text.find("#SBATCH --array=0-2%2\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("--shard \"${SLURM_ARRAY_TASK_ID}/3\""), std::string::npos) << text;
+  EXPECT_NE(text.find("--manifest '" + (dir / "manifest.jsonl").string() + "'"), std::string::npos)
+      << text;
+  ASSERT_TRUE(read_slurm_script(m));
+  EXPECT_EQ(read_slurm_script(m)->shards, 3u);
+  // With only p0001-r01 (index 3) unfinished, only shard 0 goes again.
+  SweepStatus one = st;
+  for (auto& j : one.jobs) j.state = j.index == 3 ? JobState::kMissing : JobState::kDone;
+  EXPECT_EQ(resubmit_command(m, one, script),
+            "sbatch --array=0%2 '" + (dir / "slurm/sweep.sbatch").string() + "'");
+  for (auto& j : one.jobs) j.state = JobState::kDone;
+  EXPECT_EQ(resubmit_command(m, one, script), "");
+  fs::remove_all(dir);
+}
+
+TEST(SweepFolder, ShardsPartitionTheJobs) {
+  EXPECT_EQ(parse_shard("0/1").count, 1u);
+  EXPECT_EQ(parse_shard("3/4").index, 3u);
+  for (const char* bad : {"4/4", "1", "-1/3", "a/b", "1/0", "1/2/3"})
+    EXPECT_THROW(parse_shard(bad), UserError) << bad;
+  std::vector<SweepJob> jobs(10);
+  for (std::size_t k = 0; k < jobs.size(); ++k) jobs[k].index = k;
+  std::vector<int> owners(jobs.size(), 0);
+  for (std::size_t s = 0; s < 4; ++s)
+    for (const auto& j : jobs) owners[j.index] += in_shard(j, {s, 4});
+  for (int o : owners) EXPECT_EQ(o, 1);
+  EXPECT_EQ(array_ranges({0, 1, 2, 5, 7, 8}), "0-2,5,7-8");
+  EXPECT_EQ(array_ranges({3}), "3");
+  EXPECT_EQ(array_ranges({}), "");
+}
+
+TEST(SweepFiles, ShippedSweepsAndTheCiBaselineAreValid) {
+  std::vector<fs::path> files = {kSource / "examples/ci/mini_sweep.yaml"};
+  for (const auto& e : fs::directory_iterator(kSource / "scenarios/sweeps"))
+    if (e.path().extension() == ".yaml") files.push_back(e.path());
+  EXPECT_GE(files.size(), 4u);  // yaw_variability, feature_depth, wave_amplitude, the CI one
+  for (const auto& f : files) {
+    SCOPED_TRACE(f.string());
+    const SweepPlan plan = plan_sweep(load_sweep(f));
+    EXPECT_GE(plan.jobs.size(), 4u);
+  }
+  const Baseline b = load_baseline(kSource / "examples/ci/baseline.json");
+  EXPECT_GE(b.metrics.size(), 5u);
+  for (const auto& m : b.metrics) EXPECT_TRUE(m.baseline.has_value()) << m.key;
+}
+
+TEST(SweepMerge, ConfidenceIntervalUsesStudentsT) {
+  // t quantiles 0.975 with 1 and 4 degrees of freedom: 12.706204736174698, 2.7764451051977934.
+  auto [lo2, hi2] = confidence_interval_95(10.0, 1.0, 2);
+  EXPECT_NEAR(hi2 - 10.0, 12.706204736174698 / std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(10.0 - lo2, 12.706204736174698 / std::sqrt(2.0), 1e-9);
+  auto [lo5, hi5] = confidence_interval_95(0.0, 2.0, 5);
+  EXPECT_NEAR(hi5, 2.7764451051977934 * 2.0 / std::sqrt(5.0), 1e-9);
+  EXPECT_NEAR(lo5, -hi5, 1e-12);
+  auto [lo1, hi1] = confidence_interval_95(3.0, 0.0, 1);
+  EXPECT_EQ(lo1, 3.0);
+  EXPECT_EQ(hi1, 3.0);
+}
+
+// ---------------------------------------------------------------------------
+// Through the CLI: runs, resume, merge.
+
+struct Result {
+  int exit_code;
+  std::string out, err;
+};
+
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+Result run_cli(const std::vector<std::string>& args) {
+  const fs::path base =
+      fs::temp_directory_path() / ("driftlab_sweep_cli_" + std::to_string(::getpid()));
+  std::string cmd = quote(kCli.string());
+  for (const auto& a : args) cmd += " " + quote(a);
+  cmd += " > " + quote(base.string() + ".out") + " 2> " + quote(base.string() + ".err");
+  const int status = std::system(cmd.c_str());
+  Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(base.string() + ".out"),
+           slurp(base.string() + ".err")};
+  fs::remove(base.string() + ".out");
+  fs::remove(base.string() + ".err");
+  return r;
+}
+
+const std::vector<std::string> kSummaryFiles = {"sections.csv", "runs.csv", "points.csv",
+                                                "metrics.json", "summary.md"};
+
+void expect_same_summary(const fs::path& a, const fs::path& b) {
+  for (const auto& f : kSummaryFiles) {
+    const std::string x = slurp(a / "summary" / f), y = slurp(b / "summary" / f);
+    EXPECT_FALSE(x.empty()) << a / "summary" / f;
+    EXPECT_TRUE(x == y) << f << " differs between " << a << " and " << b;
+  }
+}
+
+std::size_t markers(const fs::path& dir) {
+  std::size_t n = 0;
+  for (const auto& e : fs::directory_iterator(dir / "runs")) n += fs::exists(e.path() / "job.json");
+  return n;
+}
+
+TEST(SweepCli, KilledRunResumesOnlyMissingJobsAndEveryWayMergesToTheSameBytes) {
+  const fs::path root = temp_dir("resume");
+  const fs::path a = root / "a", b = root / "b", c = root / "c";
+  const std::string sweep = (kSweeps / "tiny_grid.yaml").string();
+  for (const auto& d : {a, b, c}) {
+    const Result r = run_cli({"sweep", "plan", sweep, "--out", d.string()});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  EXPECT_EQ(slurp(a / "manifest.jsonl"), slurp(b / "manifest.jsonl"));
+
+  // a: uninterrupted, two at a time.
+  Result r = run_cli({"sweep", "run", a.string(), "-j", "2"});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("4 jobs: ran 4, 0 failed, 0 already done"), std::string::npos) << r.out;
+  EXPECT_EQ(markers(a), 4u);
+
+  // b: as two shards, the way a job array runs it (0-based K).
+  for (const char* shard : {"0/2", "1/2"}) {
+    r = run_cli({"run", "--manifest", (b / "manifest.jsonl").string(), "--shard", shard});
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("2 jobs: ran 2"), std::string::npos) << r.out;
+  }
+  // Shard 0/2 holds jobs 0 and 2: the finished jobs are skipped when it runs again.
+  r = run_cli({"run", "--manifest", (b / "manifest.jsonl").string(), "--shard", "0/2"});
+  EXPECT_NE(r.out.find("2 jobs: ran 0, 0 failed, 2 already done"), std::string::npos) << r.out;
+
+  // c: one at a time, killed (SIGKILL) once the first job is done, then resumed.
+  ProcessSpec spec;
+  spec.executable = kCli;
+  spec.args = {"sweep", "run", c.string(), "-j", "1"};
+  spec.output_file = root / "killed.log";
+  const pid_t pid = spawn_process(spec);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(5);
+  while (!fs::exists(c / "runs/p0000-r00/job.json") && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ::kill(pid, SIGKILL);
+  const ExitStatus killed = wait_process(pid);
+  EXPECT_FALSE(killed.exited);
+  const std::size_t done_before = markers(c);
+  ASSERT_GE(done_before, 1u);
+  ASSERT_LT(done_before, 4u) << "the run finished before it was killed";
+  std::map<std::string, std::pair<std::string, fs::file_time_type>> finished;
+  for (const auto& e : fs::directory_iterator(c / "runs"))
+    if (fs::exists(e.path() / "job.json"))
+      finished[e.path().filename()] = {slurp(e.path() / "job.json"),
+                                       fs::last_write_time(e.path() / "job.json")};
+  // The interrupted job's child got SIGTERM with its parent; its temporaries go once it is gone.
+  const SweepManifest mc = read_manifest(c);
+  while (!leftover_temporaries(mc, /*remove=*/true).empty() &&
+         std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_TRUE(leftover_temporaries(mc, false).empty());
+
+  r = run_cli({"sweep", "run", c.string(), "-j", "2"});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("4 jobs: ran " + std::to_string(4 - done_before) + ", 0 failed, " +
+                       std::to_string(done_before) + " already done"),
+            std::string::npos)
+      << r.out;
+  for (const auto& [id, before] : finished) {
+    EXPECT_EQ(slurp(c / "runs" / id / "job.json"), before.first) << id << " ran again";
+    EXPECT_EQ(fs::last_write_time(c / "runs" / id / "job.json"), before.second) << id;
+  }
+  r = run_cli({"sweep", "status", c.string()});
+  EXPECT_NE(r.out.find("4 jobs: 4 done, 0 failed, 0 stale, 0 missing"), std::string::npos) << r.out;
+
+  for (const auto& d : {a, b, c}) {
+    r = run_cli({"sweep", "merge", d.string(), "--no-plots"});
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  }
+  expect_same_summary(a, b);
+  expect_same_summary(a, c);
+
+  // The pooled table: the sweep's columns, then each run's sections.csv rows as they are.
+  const std::string pooled = slurp(a / "summary/sections.csv");
+  EXPECT_EQ(pooled.rfind("job,point,replicate,seed,yaw_amp_deg,algorithm,index,", 0), 0u)
+      << pooled.substr(0, 200);
+  std::size_t rows = 0;
+  const SweepManifest ma = read_manifest(a);
+  for (const auto& job : ma.jobs) {
+    std::istringstream in(slurp(ma.run_dir(job.id) / "sections.csv"));
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) {
+      ++rows;
+      const std::string prefix = job.id + "," + std::to_string(job.point) + "," +
+                                 std::to_string(job.replicate) + "," + std::to_string(job.seed) +
+                                 "," + (job.point == 0 ? "0" : "20") + "," + line;
+      EXPECT_NE(pooled.find(prefix + "\n"), std::string::npos) << prefix;
+    }
+  }
+  EXPECT_GT(rows, 0u);
+  EXPECT_EQ(static_cast<std::size_t>(std::count(pooled.begin(), pooled.end(), '\n')), rows + 1);
+
+  // Per point: replicates' mean of each run metric, over the runs of that point.
+  const auto metrics = nlohmann::json::parse(slurp(a / "summary/metrics.json"));
+  for (std::size_t point = 0; point < 2; ++point) {
+    double sum = 0;
+    int n = 0;
+    for (const auto& job : ma.jobs) {
+      if (job.point != point) continue;
+      const auto run = nlohmann::json::parse(slurp(ma.run_dir(job.id) / "metrics.json"));
+      sum += run["algorithms"]["sparse"]["ape"]["trans_m"]["rmse"].get<double>();
+      ++n;
+    }
+    const auto& s = metrics["points"][point == 0 ? "p0000" : "p0001"]["algorithms"]["sparse"]
+                           ["ape_trans_rmse_m"];
+    EXPECT_EQ(s["n"], n);
+    EXPECT_NEAR(s["mean"].get<double>(), sum / n, 1e-12);
+  }
+  fs::remove_all(root);
+}
+
+TEST(SweepCli, AFailingJobIsRecordedAndDoesNotStopTheOthers) {
+  const fs::path dir = temp_dir("failing");
+  Result r =
+      run_cli({"sweep", "plan", (kSweeps / "tiny_grid.yaml").string(), "--out", dir.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Job p0000-r01 now disagrees with the scenario: it fails when it loads.
+  std::string manifest = slurp(dir / "manifest.jsonl");
+  const SweepManifest m = read_manifest(dir);
+  const auto at = manifest.find(m.jobs[1].hash);
+  ASSERT_NE(at, std::string::npos);
+  manifest.replace(at, 16, "0123456789abcdef");
+  std::ofstream(dir / "manifest.jsonl") << manifest;
+
+  r = run_cli({"sweep", "run", dir.string(), "-j", "2"});
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("4 jobs: ran 4, 1 failed, 0 already done; "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("failed: p0000-r01"), std::string::npos) << r.out;
+  const auto rec = nlohmann::json::parse(slurp(dir / "failed/p0000-r01.json"));
+  EXPECT_EQ(rec["status"], "exit code 1");
+  EXPECT_NE(rec["error"].get<std::string>().find("the scenario hashes to"), std::string::npos)
+      << rec.dump(2);
+  EXPECT_FALSE(fs::exists(dir / "runs/p0000-r01"));
+  EXPECT_TRUE(fs::exists(dir / "logs/p0000-r01.log"));
+
+  r = run_cli({"sweep", "status", dir.string()});
+  EXPECT_NE(r.out.find("4 jobs: 3 done, 1 failed, 0 stale, 0 missing"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("p0000-r01  exit code 1: "), std::string::npos) << r.out;
+  // The merge refuses an incomplete sweep unless asked, and then writes nothing half-done.
+  r = run_cli({"sweep", "merge", dir.string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("1 of 4 jobs are not done (p0000-r01 failed)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "summary"));
+  r = run_cli({"sweep", "merge", dir.string(), "--allow-missing", "--no-plots"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("merged 3 runs"), std::string::npos) << r.out;
+  // A covariate that is not a column: an error naming it, the old summary left as it was.
+  const std::string before = slurp(dir / "summary/metrics.json");
+  r = run_cli({"sweep", "merge", dir.string(), "--allow-missing", "--covariates", "v,wind"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--covariates: got 'wind', expected a column of the pooled sections"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(slurp(dir / "summary/metrics.json"), before);
+  fs::remove_all(dir);
+}
+
+TEST(SweepCli, OneLocalRunnerAtATime) {
+  const fs::path dir = temp_dir("locked");
+  Result r =
+      run_cli({"sweep", "plan", (kSweeps / "tiny_grid.yaml").string(), "--out", dir.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Another runner holds the folder's lock (the protocol is flock(2) on .sweep-run.lock).
+  const int fd = ::open((dir / ".sweep-run.lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  r = run_cli({"sweep", "run", dir.string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("another `driftlab sweep run` is running the jobs of this folder"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir / "runs"));
+  ::close(fd);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace driftlab::pipeline
