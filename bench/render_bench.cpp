@@ -1,5 +1,5 @@
 // Rendering cost: stereo pairs per second of the two scenes at 640x480 and
-// 1024x768 with the default effects (MSAA 4x, water reflections), on the
+// 1024x768 with the default effects (water reflections; MSAA is off by default), on the
 // scenario's default backend (OSMesa: Mesa llvmpipe on the CPU). The issue's
 // target on the 2-core CI machine: 30 pairs/s at 640x480 (river_reach).
 #include <benchmark/benchmark.h>

@@ -8,6 +8,10 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <map>
+#include <tuple>
+#include <cstring>
+#include <cstdlib>
 
 #include "core/error.hpp"
 
@@ -19,99 +23,129 @@ constexpr float kFar = 5000.f;
 
 // --- shaders ---------------------------------------------------------------
 
-constexpr const char* kSceneVs = R"(#version 450 core
+// Shaders come in variants chosen by #defines: DEPTH (linear depth instead of
+// gray) and SUN (sun glints, which need per-pixel normals and view vectors).
+// On llvmpipe the cost of a fragment is mostly the interpolation of its
+// inputs, so each variant carries only what it reads: lighting and fog are
+// smooth over a triangle and are evaluated per vertex (Gouraud).
+constexpr const char* kSceneVs = R"(
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
 uniform mat4 u_view;       // world -> camera (optical)
 uniform mat4 u_proj;
 uniform float u_mirror;    // 1: as is; -1: mirrored about the water plane z = 0
+uniform vec3 u_sun_dir;    // towards the sun, world
+uniform float u_ambient;
+uniform float u_diffuse;
+uniform float u_fog;
+uniform vec3 u_eye;
+#if DEPTH
+out float v_view_z;
+#else
+out vec4 v_uv_light_fog;   // texture u, v; light; fog transmittance
+#endif
+#if SUN && !DEPTH
 out vec3 v_world;
 out vec3 v_normal;
-out vec2 v_uv;
-out float v_view_z;
+#endif
 void main() {
   vec3 p = vec3(a_pos.xy, a_pos.z * u_mirror);
   vec4 c = u_view * vec4(p, 1.0);
-  v_world = p;
-  v_normal = vec3(a_normal.xy, a_normal.z * u_mirror);
-  v_uv = a_uv;
+#if DEPTH
   v_view_z = c.z;
+#else
+  vec3 n = normalize(vec3(a_normal.xy, a_normal.z * u_mirror));
+  // Overcast light comes mostly from above (-z); the sun adds a directional term.
+  // Surfaces facing down still get light bounced from the water and ground.
+  float sky_light = mix(0.35, 1.0, 0.5 + 0.5 * clamp(-n.z, -1.0, 1.0));
+#if SUN
+  float light = u_ambient * sky_light + u_diffuse * max(dot(n, u_sun_dir), 0.0);
+  v_world = p;
+  v_normal = n;
+#else
+  float light = u_ambient * sky_light + u_diffuse * 0.6 * sky_light;
+#endif
+  v_uv_light_fog = vec4(a_uv, light, exp(-length(u_eye - p) / u_fog));
+#endif
   // Mirrored pass: keep only what is above the water (z < 0 before mirroring).
   gl_ClipDistance[0] = u_mirror < 0.0 ? -a_pos.z : 1.0;
   gl_Position = u_proj * c;
 }
 )";
 
-constexpr const char* kSceneFs = R"(#version 450 core
+constexpr const char* kSceneFs = R"(
+#if DEPTH
+in float v_view_z;
+#else
+in vec4 v_uv_light_fog;
+#endif
+#if SUN && !DEPTH
 in vec3 v_world;
 in vec3 v_normal;
-in vec2 v_uv;
-in float v_view_z;
+#endif
 uniform sampler2D u_tex;
 uniform bool u_has_tex;
 uniform float u_albedo;
 uniform float u_specular;
-uniform vec3 u_sun_dir;    // towards the sun, world
-uniform bool u_sun;
-uniform float u_ambient;
-uniform float u_diffuse;
+uniform vec3 u_sun_dir;
 uniform float u_sky;
-uniform float u_fog;
 uniform vec3 u_eye;
-uniform int u_mode;        // 0 gray, 1 linear depth
 out vec4 frag;
 void main() {
-  if (u_mode == 1) { frag = vec4(v_view_z, 0.0, 0.0, 1.0); return; }
-  vec3 n = normalize(v_normal);
-  float t = u_has_tex ? texture(u_tex, v_uv).r : 1.0;
-  // Overcast light comes mostly from above (-z); the sun adds a directional term.
-  // Surfaces facing down still get light bounced from the water and ground.
-  float sky_light = mix(0.35, 1.0, 0.5 + 0.5 * clamp(-n.z, -1.0, 1.0));
-  float lambert = max(dot(n, u_sun_dir), 0.0);
-  float light = u_ambient * sky_light + u_diffuse * (u_sun ? lambert : 0.6 * sky_light);
-  float g = u_albedo * t * light;
-  if (u_sun && u_specular > 0.0) {
+#if DEPTH
+  frag = vec4(v_view_z, 0.0, 0.0, 1.0);
+#else
+  float t = u_has_tex ? texture(u_tex, v_uv_light_fog.xy).r : 1.0;
+  float g = u_albedo * t * v_uv_light_fog.z;
+#if SUN
+  if (u_specular > 0.0) {
+    vec3 n = normalize(v_normal);
     vec3 v = normalize(u_eye - v_world);
     vec3 h = normalize(v + u_sun_dir);
     g += u_specular * pow(max(dot(n, h), 0.0), 60.0);
   }
-  float d = length(u_eye - v_world);
-  float f = exp(-d / u_fog);
-  frag = vec4(mix(u_sky, g, f), 0.0, 0.0, 1.0);
+#endif
+  frag = vec4(mix(u_sky, g, v_uv_light_fog.w), 0.0, 0.0, 1.0);
+#endif
 }
 )";
 
-constexpr const char* kSkyVs = R"(#version 450 core
-out vec2 v_ndc;
+// The sky: one triangle over the screen on the far plane. The (unnormalised)
+// viewing ray is affine in window coordinates, so it is computed at the
+// vertices and interpolated without perspective: exact, and cheap per pixel.
+constexpr const char* kSkyVs = R"(
+uniform mat4 u_inv_view_proj;
+noperspective out vec3 v_ray;
 void main() {
   vec2 p = vec2((gl_VertexID == 1) ? 3.0 : -1.0, (gl_VertexID == 2) ? 3.0 : -1.0);
-  v_ndc = p;
+  vec4 a = u_inv_view_proj * vec4(p, -1.0, 1.0);
+  vec4 b = u_inv_view_proj * vec4(p, 1.0, 1.0);
+  v_ray = b.xyz / b.w - a.xyz / a.w;
   gl_Position = vec4(p, 1.0, 1.0);
 }
 )";
 
-constexpr const char* kSkyFs = R"(#version 450 core
-in vec2 v_ndc;
-uniform mat4 u_inv_view_proj;
+constexpr const char* kSkyFs = R"(
+noperspective in vec3 v_ray;
 uniform float u_sky;
-uniform bool u_sun;
 uniform vec3 u_sun_dir;
 out vec4 frag;
 void main() {
-  vec4 a = u_inv_view_proj * vec4(v_ndc, -1.0, 1.0);
-  vec4 b = u_inv_view_proj * vec4(v_ndc, 1.0, 1.0);
-  vec3 d = normalize(b.xyz / b.w - a.xyz / a.w);
+  vec3 d = normalize(v_ray);
   float elevation = clamp(-d.z, 0.0, 1.0);   // z is down
   float g = u_sky * (1.0 + 0.12 * elevation);
-  if (u_sun) g += 0.35 * pow(max(dot(d, u_sun_dir), 0.0), 200.0);
+#if SUN
+  g += 0.35 * pow(max(dot(d, u_sun_dir), 0.0), 200.0);
+#endif
   frag = vec4(min(g, 1.0), 0.0, 0.0, 1.0);
 }
 )";
 
 // The water: a polar grid around the camera displaced by the wave components
-// (eta positive up, surface at z = -eta), normals from the analytic slope.
-constexpr const char* kWaterVs = R"(#version 450 core
+// (eta positive up, surface at z = -eta), normals from the analytic slope at
+// the vertices (as fine as the displaced geometry itself).
+constexpr const char* kWaterVs = R"(
 layout(location = 0) in vec2 a_grid;       // offset from the camera, world x/y
 const int N = 32;
 uniform vec4 u_wave_a[N];   // amplitude, kx, ky, omega
@@ -121,70 +155,86 @@ uniform float u_time;
 uniform vec2 u_centre;
 uniform mat4 u_view;
 uniform mat4 u_proj;
-out vec3 v_world;
+uniform vec3 u_eye;
+uniform float u_fog;
+uniform float u_reflectivity;
+uniform float u_turbidity;
+#if DEPTH
 out float v_view_z;
+#else
+out vec4 v_shade;          // normal x, y (reflection offset); Fresnel; fog
+#endif
+#if SUN && !DEPTH
+out vec3 v_world;
+out vec3 v_normal;
+#endif
 void main() {
   vec2 xy = u_centre + a_grid;
   float eta = 0.0;
+  vec2 slope = vec2(0.0);
   for (int i = 0; i < u_wave_count; ++i) {
     float th = u_wave_a[i].y * xy.x + u_wave_a[i].z * xy.y - u_wave_a[i].w * u_time + u_wave_phase[i];
     eta += u_wave_a[i].x * cos(th);
+    slope -= u_wave_a[i].x * sin(th) * u_wave_a[i].yz;
   }
   vec3 p = vec3(xy, -eta);
   vec4 c = u_view * vec4(p, 1.0);
-  v_world = p;
+#if DEPTH
   v_view_z = c.z;
+#else
+  vec3 n = normalize(vec3(-slope, -1.0));   // upward normal (z is down)
+  vec3 v = normalize(u_eye - p);
+  float cos_t = clamp(dot(n, v), 0.0, 1.0);
+  // Schlick's approximation of the Fresnel reflectance of water (n = 1.33).
+  float m = 1.0 - cos_t, m2 = m * m;
+  float fresnel = (0.02 + 0.98 * m2 * m2 * m) * u_reflectivity * (1.0 - 0.5 * u_turbidity);
+  v_shade = vec4(n.xy, fresnel, exp(-length(u_eye - p) / u_fog));
+#if SUN
+  v_world = p;
+  v_normal = n;
+#endif
+#endif
   gl_Position = u_proj * c;
 }
 )";
 
-constexpr const char* kWaterFs = R"(#version 450 core
-in vec3 v_world;
+constexpr const char* kWaterFs = R"(
+#if DEPTH
 in float v_view_z;
-const int N = 32;
-uniform vec4 u_wave_a[N];
-uniform float u_wave_phase[N];
-uniform int u_wave_count;
-uniform float u_time;
+#else
+in vec4 v_shade;
+#endif
+#if SUN && !DEPTH
+in vec3 v_world;
+in vec3 v_normal;
+#endif
 uniform vec3 u_eye;
 uniform sampler2D u_reflection;
 uniform bool u_has_reflection;
 uniform vec2 u_viewport;
 uniform float u_body;
 uniform float u_turbidity;
-uniform float u_reflectivity;
 uniform float u_sky;
-uniform float u_fog;
-uniform bool u_sun;
 uniform vec3 u_sun_dir;
-uniform int u_mode;
 out vec4 frag;
 void main() {
-  if (u_mode == 1) { frag = vec4(v_view_z, 0.0, 0.0, 1.0); return; }
-  vec2 slope = vec2(0.0);
-  for (int i = 0; i < u_wave_count; ++i) {
-    float th = u_wave_a[i].y * v_world.x + u_wave_a[i].z * v_world.y - u_wave_a[i].w * u_time + u_wave_phase[i];
-    slope -= u_wave_a[i].x * sin(th) * u_wave_a[i].yz;
-  }
-  vec3 n = normalize(vec3(-slope, -1.0));       // upward normal (z is down)
-  vec3 v = normalize(u_eye - v_world);
-  float cos_t = clamp(dot(n, v), 0.0, 1.0);
-  // Schlick's approximation of the Fresnel reflectance of water (n = 1.33).
-  float fresnel = 0.02 + 0.98 * pow(1.0 - cos_t, 5.0);
-  fresnel *= u_reflectivity * (1.0 - 0.5 * u_turbidity);
+#if DEPTH
+  frag = vec4(v_view_z, 0.0, 0.0, 1.0);
+#else
   float refl = u_sky;
   if (u_has_reflection) {
-    vec2 uv = gl_FragCoord.xy / u_viewport + 0.6 * n.xy * vec2(1.0, -1.0) * 0.25;
+    vec2 uv = gl_FragCoord.xy / u_viewport + 0.15 * v_shade.xy * vec2(1.0, -1.0);
     refl = texture(u_reflection, clamp(uv, vec2(0.0), vec2(1.0))).r;
   }
   float body = u_body * (0.6 + 0.8 * u_turbidity);
-  float g = mix(body, refl, fresnel);
-  if (u_sun) {
-    vec3 r = reflect(-v, n);
-    g += 0.8 * pow(max(dot(r, u_sun_dir), 0.0), 300.0);
-  }
-  float d = length(u_eye - v_world);
-  frag = vec4(mix(u_sky, g, exp(-d / u_fog)), 0.0, 0.0, 1.0);
+  float g = mix(body, refl, v_shade.z);
+#if SUN
+  vec3 n = normalize(v_normal);
+  vec3 r = reflect(-normalize(u_eye - v_world), n);
+  g += 0.8 * pow(max(dot(r, u_sun_dir), 0.0), 300.0);
+#endif
+  frag = vec4(mix(u_sky, g, v_shade.w), 0.0, 0.0, 1.0);
+#endif
 }
 )";
 
@@ -202,10 +252,11 @@ GLuint compile(GLenum type, const char* source, const char* what) {
   return s;
 }
 
-GLuint program(const char* vs, const char* fs, const char* what) {
+GLuint program(const char* vs, const char* fs, const char* what, const std::string& defines = "") {
   const GLuint p = glCreateProgram();
-  const GLuint v = compile(GL_VERTEX_SHADER, vs, what);
-  const GLuint f = compile(GL_FRAGMENT_SHADER, fs, what);
+  const std::string head = "#version 450 core\n" + defines;
+  const GLuint v = compile(GL_VERTEX_SHADER, (head + vs).c_str(), what);
+  const GLuint f = compile(GL_FRAGMENT_SHADER, (head + fs).c_str(), what);
   glAttachShader(p, v);
   glAttachShader(p, f);
   glLinkProgram(p);
@@ -276,7 +327,9 @@ struct StereoRenderer::Impl {
   StereoRig rig;
   RenderOptions options;
   std::unique_ptr<GlContext> context;
-  GLuint scene_prog = 0, sky_prog = 0, water_prog = 0;
+  // Programs by variant: [mode][sun] with mode 0 gray, 1 linear depth.
+  GLuint scene_progs[2][2] = {}, water_progs[2][2] = {};
+  GLuint sky_progs[2] = {};  // [sun]
   GLuint empty_vao = 0;
   std::vector<GpuMesh> meshes;
   std::vector<GLuint> textures;
@@ -284,21 +337,35 @@ struct StereoRenderer::Impl {
   std::size_t triangle_count = 0;
   GLuint water_vao = 0, water_vbo = 0, water_ebo = 0;
   GLsizei water_count = 0;
+  int water_segments = 0;
+  float water_radius_m = 0;
+  float wave_amplitude_sum_m = 0;
   std::vector<float> wave_a;      // 4 per component
   std::vector<float> wave_phase;
   // Framebuffers.
-  GLuint msaa_fbo = 0, msaa_color = 0, msaa_depth = 0;
-  GLuint resolve_fbo = 0, resolve_tex = 0;
-  GLuint refl_fbo = 0, refl_tex = 0, refl_depth = 0;
+  // Framebuffers, one set per eye: both eyes are drawn before either is read
+  // back, so llvmpipe rasterises the left eye while the right eye's vertices
+  // are processed on this thread.
+  struct EyeTargets {
+    GLuint msaa_fbo = 0, msaa_color = 0, msaa_depth = 0;
+    GLuint resolve_fbo = 0, resolve_tex = 0;
+    GLuint refl_fbo = 0, refl_tex = 0, refl_depth = 0;
+  };
+  std::array<EyeTargets, 2> eyes;
   GLuint depth_fbo = 0, depth_tex = 0, depth_rb = 0;
   Eigen::Matrix4f proj;
+  std::vector<std::pair<float, std::size_t>> draw_order;  // scratch for draw_scene
 
   void build_water_grid();
   void build_framebuffers();
+  void build_eye_targets(EyeTargets* e);
+  void color_target_(GLuint* fbo, GLuint* tex, unsigned format, GLuint* depth_rb, int W, int H);
   void draw_scene(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, float mirror, int mode);
   void draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, double t, int mode,
-                  bool with_reflection);
-  GrayImage render_eye(const SE3& T_W_C, double t);
+                  GLuint reflection);  // 0: none
+  void draw_sky(const Eigen::Matrix4f& view);
+  void draw_eye(const SE3& T_W_C, double t, int eye);
+  GrayImage read_eye(int eye);
   DepthImage render_depth(const SE3& T_W_C, double t);
 };
 
@@ -310,9 +377,14 @@ StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& option
   impl_->rig = rig;
   impl_->options = options;
   impl_->context = create_gl_context(options.backend);
-  impl_->scene_prog = program(kSceneVs, kSceneFs, "scene");
-  impl_->sky_prog = program(kSkyVs, kSkyFs, "sky");
-  impl_->water_prog = program(kWaterVs, kWaterFs, "water");
+  for (int mode : {0, 1})
+    for (int sun : {0, 1}) {
+      const std::string defines = fmt::format("#define DEPTH {}\n#define SUN {}\n", mode, sun);
+      impl_->scene_progs[mode][sun] = program(kSceneVs, kSceneFs, "scene", defines);
+      impl_->water_progs[mode][sun] = program(kWaterVs, kWaterFs, "water", defines);
+    }
+  for (int sun : {0, 1})
+    impl_->sky_progs[sun] = program(kSkyVs, kSkyFs, "sky", fmt::format("#define SUN {}\n", sun));
   glGenVertexArrays(1, &impl_->empty_vao);
   impl_->proj = projection_from_intrinsics(rig.camera, kNear, kFar);
   impl_->build_water_grid();
@@ -347,18 +419,20 @@ void StereoRenderer::Impl::build_water_grid() {
       v.push_back(r * std::sin(a));
     }
   }
+  // Indices wedge by wedge (all rings of one angular segment together), so
+  // that the wedges in view are contiguous runs of the index buffer.
   std::vector<std::uint32_t> idx;
   for (int j = 0; j < segments; ++j) {
-    idx.push_back(0);
-    idx.push_back(1 + j);
-    idx.push_back(1 + (j + 1) % segments);
-  }
-  for (int i = 0; i + 1 < rings; ++i)
-    for (int j = 0; j < segments; ++j) {
+    idx.insert(idx.end(), {0u, static_cast<std::uint32_t>(1 + j),
+                           static_cast<std::uint32_t>(1 + (j + 1) % segments)});
+    for (int i = 0; i + 1 < rings; ++i) {
       const std::uint32_t a = 1 + i * segments + j, b = 1 + i * segments + (j + 1) % segments;
       const std::uint32_t c = a + segments, d = b + segments;
       idx.insert(idx.end(), {a, c, b, b, c, d});
     }
+  }
+  water_segments = segments;
+  water_radius_m = r1;
   glGenVertexArrays(1, &water_vao);
   glBindVertexArray(water_vao);
   glGenBuffers(1, &water_vbo);
@@ -375,55 +449,57 @@ void StereoRenderer::Impl::build_water_grid() {
   glBindVertexArray(0);
 }
 
+void StereoRenderer::Impl::color_target_(GLuint* fbo, GLuint* tex, unsigned format, GLuint* depth_rb,
+                                         int W, int H) {
+  glGenFramebuffers(1, fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
+  glGenTextures(1, tex);
+  glBindTexture(GL_TEXTURE_2D, *tex);
+  glTexStorage2D(GL_TEXTURE_2D, 1, format, W, H);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, *tex, 0);
+  if (depth_rb) {
+    glGenRenderbuffers(1, depth_rb);
+    glBindRenderbuffer(GL_RENDERBUFFER, *depth_rb);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, W, H);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, *depth_rb);
+  }
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw InternalError("renderer: incomplete framebuffer");
+}
+
 void StereoRenderer::Impl::build_framebuffers() {
   const int W = rig.camera.width, H = rig.camera.height;
+  for (EyeTargets& e : eyes) build_eye_targets(&e);
+  color_target_(&depth_fbo, &depth_tex, GL_R32F, &depth_rb, W, H);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void StereoRenderer::Impl::build_eye_targets(EyeTargets* e) {
+  const int W = rig.camera.width, H = rig.camera.height;
   const int samples = options.msaa_samples;
-  glGenFramebuffers(1, &msaa_fbo);
-  glBindFramebuffer(GL_FRAMEBUFFER, msaa_fbo);
-  glGenRenderbuffers(1, &msaa_color);
-  glBindRenderbuffer(GL_RENDERBUFFER, msaa_color);
+  glGenFramebuffers(1, &e->msaa_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, e->msaa_fbo);
+  glGenRenderbuffers(1, &e->msaa_color);
+  glBindRenderbuffer(GL_RENDERBUFFER, e->msaa_color);
   glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, GL_R8, W, H);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, msaa_color);
-  glGenRenderbuffers(1, &msaa_depth);
-  glBindRenderbuffer(GL_RENDERBUFFER, msaa_depth);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, e->msaa_color);
+  glGenRenderbuffers(1, &e->msaa_depth);
+  glBindRenderbuffer(GL_RENDERBUFFER, e->msaa_depth);
   glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0,
                                    GL_DEPTH_COMPONENT32F, W, H);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, msaa_depth);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, e->msaa_depth);
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
     throw UserError(fmt::format("renderer: the {}x{} framebuffer with {} samples is not supported",
                                 W, H, samples));
 
-  auto color_target = [&](GLuint* fbo, GLuint* tex, GLenum format, GLuint* depth_rb, int W = 0,
-                          int H = 0) {
-    if (W == 0) {
-      W = rig.camera.width;
-      H = rig.camera.height;
-    }
-    glGenFramebuffers(1, fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
-    glGenTextures(1, tex);
-    glBindTexture(GL_TEXTURE_2D, *tex);
-    glTexStorage2D(GL_TEXTURE_2D, 1, format, W, H);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, *tex, 0);
-    if (depth_rb) {
-      glGenRenderbuffers(1, depth_rb);
-      glBindRenderbuffer(GL_RENDERBUFFER, *depth_rb);
-      glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, W, H);
-      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, *depth_rb);
-    }
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      throw InternalError("renderer: incomplete framebuffer");
-  };
-  color_target(&resolve_fbo, &resolve_tex, GL_R8, nullptr);
+  color_target_(&e->resolve_fbo, &e->resolve_tex, GL_R8, nullptr, W, H);
   // The reflection is blurred by the waves and the Fresnel mix anyway: half
   // resolution costs a quarter of the fill for no visible loss.
-  color_target(&refl_fbo, &refl_tex, GL_R8, &refl_depth, (W + 1) / 2, (H + 1) / 2);
-  color_target(&depth_fbo, &depth_tex, GL_R32F, &depth_rb);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  color_target_(&e->refl_fbo, &e->refl_tex, GL_R8, &e->refl_depth, (W + 1) / 2, (H + 1) / 2);
 }
 
 void StereoRenderer::upload(const SceneGeometry& scene) {
@@ -455,11 +531,37 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     m.textures.push_back(tex);
   }
   m.triangle_count = 0;
-  for (const Mesh& mesh : scene.meshes) {
-    if (mesh.indices.empty()) continue;
-    for (std::uint32_t i : mesh.indices)
-      if (i >= mesh.vertices.size())
-        throw InternalError(fmt::format("renderer: mesh '{}' has an index out of range", mesh.name));
+  // Batches: meshes of one material whose centres fall in the same square of
+  // kBatchCell_m are drawn as one. Every draw call costs llvmpipe state
+  // validation on this thread; the squares keep culling useful on long reaches.
+  constexpr float kBatchCell_m = 50.f;
+  std::vector<Mesh> merged;
+  std::map<std::tuple<int, float, float, long, long>, std::size_t> batch_of;
+  for (const Mesh& x : scene.meshes) {
+    if (x.indices.empty()) continue;
+    for (std::uint32_t i : x.indices)
+      if (i >= x.vertices.size())
+        throw InternalError(fmt::format("renderer: mesh '{}' has an index out of range", x.name));
+    Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = -lo;
+    for (const Vertex& v : x.vertices) {
+      lo = lo.cwiseMin(Eigen::Vector3f(v.x, v.y, v.z));
+      hi = hi.cwiseMax(Eigen::Vector3f(v.x, v.y, v.z));
+    }
+    const Eigen::Vector3f c = 0.5f * (lo + hi);
+    const auto key = std::make_tuple(x.material.texture, x.material.albedo, x.material.specular,
+                                     std::lround(std::floor(c.x() / kBatchCell_m)),
+                                     std::lround(std::floor(c.y() / kBatchCell_m)));
+    const auto [it, fresh] = batch_of.emplace(key, merged.size());
+    if (fresh) {
+      merged.push_back(x);
+      continue;
+    }
+    Mesh& d = merged[it->second];
+    const auto base = static_cast<std::uint32_t>(d.vertices.size());
+    d.vertices.insert(d.vertices.end(), x.vertices.begin(), x.vertices.end());
+    for (std::uint32_t i : x.indices) d.indices.push_back(base + i);
+  }
+  for (const Mesh& mesh : merged) {
     if (mesh.material.texture >= static_cast<int>(scene.textures.size()))
       throw InternalError(fmt::format("renderer: mesh '{}' names a missing texture", mesh.name));
     GpuMesh g;
@@ -507,6 +609,7 @@ void StereoRenderer::set_waves(const std::vector<WaveComponent>& components) {
     c.resize(kMaxShaderWaveComponents);
   impl_->wave_a.clear();
   impl_->wave_phase.clear();
+  impl_->wave_amplitude_sum_m = 0;
   for (const auto& w : c) {
     impl_->wave_a.insert(impl_->wave_a.end(),
                          {static_cast<float>(w.amplitude_m),
@@ -514,32 +617,42 @@ void StereoRenderer::set_waves(const std::vector<WaveComponent>& components) {
                           static_cast<float>(w.wavenumber_rad_m * std::sin(w.direction_rad)),
                           static_cast<float>(w.omega_rad_s)});
     impl_->wave_phase.push_back(static_cast<float>(w.phase_rad));
+    impl_->wave_amplitude_sum_m += static_cast<float>(std::abs(w.amplitude_m));
   }
 }
 
 void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye,
                                       float mirror, int mode) {
   const Lighting& L = scene.lighting;
+  const GLuint scene_prog = scene_progs[mode][L.sun ? 1 : 0];
   glUseProgram(scene_prog);
   set_mat4(scene_prog, "u_view", view);
   set_mat4(scene_prog, "u_proj", proj);
   glUniform1f(loc(scene_prog, "u_mirror"), mirror);
   const Eigen::Vector3f sun = L.sun_direction_W.normalized();
   glUniform3f(loc(scene_prog, "u_sun_dir"), sun.x(), sun.y(), sun.z());
-  glUniform1i(loc(scene_prog, "u_sun"), L.sun ? 1 : 0);
   glUniform1f(loc(scene_prog, "u_ambient"), L.ambient);
   glUniform1f(loc(scene_prog, "u_diffuse"), L.diffuse);
   glUniform1f(loc(scene_prog, "u_sky"), L.sky_brightness);
   glUniform1f(loc(scene_prog, "u_fog"), L.fog_distance_m);
   glUniform3f(loc(scene_prog, "u_eye"), eye.x(), eye.y(), eye.z() * mirror);
-  glUniform1i(loc(scene_prog, "u_mode"), mode);
   glUniform1i(loc(scene_prog, "u_tex"), 0);
   glActiveTexture(GL_TEXTURE0);
   // Meshes outside the view are skipped: a CPU rasteriser is bound by vertex work.
+  // Nearest first, so that llvmpipe's early depth test skips shading hidden
+  // fragments (the tree line and the banks overlap several times over).
   const auto planes = frustum_planes(proj * view);
-  for (const GpuMesh& g : meshes) {
+  const Eigen::Vector3f eye_m(eye.x(), eye.y(), eye.z() * mirror);
+  draw_order.clear();
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    const GpuMesh& g = meshes[i];
     const Eigen::Vector3f c(g.centre.x(), g.centre.y(), g.centre.z() * mirror);
     if (!sphere_visible(planes, c, g.radius)) continue;
+    draw_order.emplace_back(std::max(0.f, (c - eye_m).norm() - g.radius), i);
+  }
+  std::sort(draw_order.begin(), draw_order.end());
+  for (const auto& [distance, index] : draw_order) {
+    const GpuMesh& g = meshes[index];
     const bool has_tex = g.material.texture >= 0;
     glUniform1i(loc(scene_prog, "u_has_tex"), has_tex ? 1 : 0);
     if (has_tex) glBindTexture(GL_TEXTURE_2D, textures[static_cast<std::size_t>(g.material.texture)]);
@@ -552,10 +665,11 @@ void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::
 }
 
 void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye,
-                                      double t, int mode, bool with_reflection) {
+                                      double t, int mode, GLuint reflection) {
   if (!scene.water.enabled) return;
   const Lighting& L = scene.lighting;
   const WaterAppearance& w = scene.water;
+  const GLuint water_prog = water_progs[mode][L.sun ? 1 : 0];
   glUseProgram(water_prog);
   set_mat4(water_prog, "u_view", view);
   set_mat4(water_prog, "u_proj", proj);
@@ -569,7 +683,7 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   glUniform1f(loc(water_prog, "u_time"), static_cast<float>(t));
   glUniform2f(loc(water_prog, "u_centre"), eye.x(), eye.y());
   glUniform3f(loc(water_prog, "u_eye"), eye.x(), eye.y(), eye.z());
-  glUniform1i(loc(water_prog, "u_has_reflection"), with_reflection ? 1 : 0);
+  glUniform1i(loc(water_prog, "u_has_reflection"), reflection != 0 ? 1 : 0);
   glUniform2f(loc(water_prog, "u_viewport"), static_cast<float>(rig.camera.width),
               static_cast<float>(rig.camera.height));
   glUniform1f(loc(water_prog, "u_body"), w.body_gray);
@@ -577,63 +691,112 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   glUniform1f(loc(water_prog, "u_reflectivity"), w.reflectivity);
   glUniform1f(loc(water_prog, "u_sky"), L.sky_brightness);
   glUniform1f(loc(water_prog, "u_fog"), L.fog_distance_m);
-  glUniform1i(loc(water_prog, "u_sun"), L.sun ? 1 : 0);
   const Eigen::Vector3f sun = L.sun_direction_W.normalized();
   glUniform3f(loc(water_prog, "u_sun_dir"), sun.x(), sun.y(), sun.z());
-  glUniform1i(loc(water_prog, "u_mode"), mode);
   glUniform1i(loc(water_prog, "u_reflection"), 0);
   glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, refl_tex);
+  glBindTexture(GL_TEXTURE_2D, reflection);
+  // Only the wedges of the grid that reach into the view are drawn: each
+  // wedge lies inside the triangle (camera, two far corners) widened to hold
+  // the arc, thickened by the sum of the wave amplitudes; it is skipped when
+  // all six corners are outside one frustum plane.
+  const auto planes = frustum_planes(proj * view);
+  const float h = wave_amplitude_sum_m + 0.01f;
+  const float reach = water_radius_m / std::cos(std::numbers::pi_v<float> / water_segments);
+  auto wedge_visible = [&](int j) {
+    const Eigen::Vector2f c(eye.x(), eye.y());
+    std::array<Eigen::Vector2f, 3> xy;
+    xy[0] = c;
+    for (int k = 0; k < 2; ++k) {
+      const float a = 2.f * std::numbers::pi_v<float> * static_cast<float>(j + k) / water_segments;
+      xy[static_cast<std::size_t>(k + 1)] = c + reach * Eigen::Vector2f(std::cos(a), std::sin(a));
+    }
+    for (const auto& q : planes) {
+      bool all_out = true;
+      for (const auto& p : xy)
+        for (float z : {-h, h})
+          all_out = all_out && q.head<3>().dot(Eigen::Vector3f(p.x(), p.y(), z)) + q.w() < 0;
+      if (all_out) return false;
+    }
+    return true;
+  };
+  const GLsizei per_wedge = water_count / water_segments;
   glBindVertexArray(water_vao);
-  glDrawElements(GL_TRIANGLES, water_count, GL_UNSIGNED_INT, nullptr);
+  for (int j = 0; j < water_segments;) {
+    if (!wedge_visible(j)) {
+      ++j;
+      continue;
+    }
+    int k = j + 1;
+    while (k < water_segments && wedge_visible(k)) ++k;
+    glDrawElements(GL_TRIANGLES, (k - j) * per_wedge, GL_UNSIGNED_INT,
+                   reinterpret_cast<void*>(static_cast<std::uintptr_t>(j) * per_wedge * 4));
+    j = k;
+  }
   glBindVertexArray(0);
 }
 
-GrayImage StereoRenderer::Impl::render_eye(const SE3& T_W_C, double t) {
+void StereoRenderer::Impl::draw_sky(const Eigen::Matrix4f& view) {
+  // The sky triangle lies on the far plane (depth 1): it passes the depth
+  // test only where the cleared depth is left.
+  glDepthFunc(GL_LEQUAL);
+  glDepthMask(GL_FALSE);
+  const GLuint sky_prog = sky_progs[scene.lighting.sun ? 1 : 0];
+  glUseProgram(sky_prog);
+  const Eigen::Matrix4f inv_vp = (proj * view).inverse();
+  set_mat4(sky_prog, "u_inv_view_proj", inv_vp);
+  glUniform1f(loc(sky_prog, "u_sky"), scene.lighting.sky_brightness);
+  const Eigen::Vector3f sun = scene.lighting.sun_direction_W.normalized();
+  glUniform3f(loc(sky_prog, "u_sun_dir"), sun.x(), sun.y(), sun.z());
+  glBindVertexArray(empty_vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_LESS);
+}
+
+void StereoRenderer::Impl::draw_eye(const SE3& T_W_C, double t, int eye_index) {
+  const EyeTargets& e = eyes[static_cast<std::size_t>(eye_index)];
   const int W = rig.camera.width, H = rig.camera.height;
   const Eigen::Matrix4f view = to_view(T_W_C);
   const Eigen::Vector3f eye = T_W_C.translation().cast<float>();
   const bool reflect = scene.water.enabled && options.reflections;
-  glViewport(0, 0, W, H);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
   if (reflect) {
     // The scene mirrored in the water plane, seen from the same camera.
-    glBindFramebuffer(GL_FRAMEBUFFER, refl_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, e.refl_fbo);
     glViewport(0, 0, (W + 1) / 2, (H + 1) / 2);
     glClearColor(scene.lighting.sky_brightness, 0, 0, 1);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_CLIP_DISTANCE0);
     draw_scene(view, eye, -1.f, 0);
     glDisable(GL_CLIP_DISTANCE0);
-    glViewport(0, 0, W, H);
   }
-  glBindFramebuffer(GL_FRAMEBUFFER, msaa_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, e.msaa_fbo);
+  glViewport(0, 0, W, H);
   glClearColor(0, 0, 0, 1);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  // Sky first, without depth (it lies on the far plane).
-  glDisable(GL_DEPTH_TEST);
-  glDepthMask(GL_FALSE);
-  glUseProgram(sky_prog);
-  const Eigen::Matrix4f inv_vp = (proj * view).inverse();
-  set_mat4(sky_prog, "u_inv_view_proj", inv_vp);
-  glUniform1f(loc(sky_prog, "u_sky"), scene.lighting.sky_brightness);
-  glUniform1i(loc(sky_prog, "u_sun"), scene.lighting.sun ? 1 : 0);
-  const Eigen::Vector3f sun = scene.lighting.sun_direction_W.normalized();
-  glUniform3f(loc(sky_prog, "u_sun_dir"), sun.x(), sun.y(), sun.z());
-  glBindVertexArray(empty_vao);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  glDepthMask(GL_TRUE);
-  glEnable(GL_DEPTH_TEST);
+  // The water first (near and large, it hides much of the banks below it),
+  // then the scene nearest first, then the sky on the far plane where nothing
+  // was drawn: every pixel is shaded about once.
+  draw_water(view, eye, t, 0, reflect ? e.refl_tex : 0);
   draw_scene(view, eye, 1.f, 0);
-  draw_water(view, eye, t, 0, reflect);
-  // Resolve the samples, then read back.
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, msaa_fbo);
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
-  glBlitFramebuffer(0, 0, W, H, 0, 0, W, H, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo);
-  glFinish();
+  draw_sky(view);
+  if (options.msaa_samples > 1) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, e.msaa_fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.resolve_fbo);
+    glBlitFramebuffer(0, 0, W, H, 0, 0, W, H, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+GrayImage StereoRenderer::Impl::read_eye(int eye_index) {
+  const EyeTargets& e = eyes[static_cast<std::size_t>(eye_index)];
+  const int W = rig.camera.width, H = rig.camera.height;
+  // Without multisampling the colour buffer is read directly (no resolve).
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, options.msaa_samples > 1 ? e.resolve_fbo : e.msaa_fbo);
   GrayImage img;
   img.width = W;
   img.height = H;
@@ -653,7 +816,7 @@ DepthImage StereoRenderer::Impl::render_depth(const SE3& T_W_C, double t) {
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
   draw_scene(view, eye, 1.f, 1);
-  draw_water(view, eye, t, 1, false);
+  draw_water(view, eye, t, 1, 0);
   glFinish();
   DepthImage d;
   d.width = W;
@@ -667,9 +830,11 @@ DepthImage StereoRenderer::Impl::render_depth(const SE3& T_W_C, double t) {
 StereoImages StereoRenderer::render(const SE3& T_W_C_left, double t_s, bool with_depth) {
   impl_->context->make_current();
   StereoImages out;
-  out.left = impl_->render_eye(T_W_C_left, t_s);
-  out.right = impl_->render_eye(T_W_C_left * impl_->rig.T_left_right(), t_s);
+  impl_->draw_eye(T_W_C_left, t_s, 0);
+  impl_->draw_eye(T_W_C_left * impl_->rig.T_left_right(), t_s, 1);
   if (with_depth) out.depth_left = impl_->render_depth(T_W_C_left, t_s);
+  out.left = impl_->read_eye(0);
+  out.right = impl_->read_eye(1);
   return out;
 }
 
