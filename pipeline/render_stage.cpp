@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "core/trajectory_io.hpp"
+#include "pipeline/camera_stage.hpp"
 #include "pipeline/run.hpp"
 #include "scenes/build_scene.hpp"
 #include "sim/render/renderer.hpp"
@@ -65,8 +66,12 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
   // Ground-truth camera poses along the mission.
   const SE3 T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
   Trajectory poses;
+  std::vector<FrameTruth> truth;
   simulate_scenario_motion(sc, nullptr, [&](const sim::BodySample& b) {
     poses.push_back({b.t_ns, b.state.T_W_B() * T_B_C});
+    Vec6 twist;
+    twist << b.state.v_B, b.state.w_B;
+    truth.push_back({ns_to_seconds(b.t_ns), b.state.T_W_B(), twist});
   });
   double north_min = 0, north_max = 0;
   for (std::size_t i = 0; i < poses.size(); ++i) {
@@ -90,23 +95,33 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
   times.write("frame,t_ns\n");
   const bool depth = options.depth || sc.render.ground_truth_depth;
   double render_s = 0;
+  // The images as the camera delivers them (blur, rig error, lens, noise) at
+  // its clock's stamps; dropped frames are not written.
+  const RngStreams rng(sc.seed);
+  CameraStage camera(sc, &renderer, rng);
+  const std::vector<sim::SampleTime> stamps =
+      sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
+  std::size_t delivered = 0;
   for (std::size_t k = 0; k < poses.size(); ++k) {
+    if (k < stamps.size() && stamps[k].dropped) continue;
     const auto t0 = Clock::now();
-    const sim::StereoImages img =
-        renderer.render(poses[k].T_W_C, ns_to_seconds(poses[k].t_ns), depth);
+    sim::StereoImages img = camera.capture(truth[k]);
+    if (depth)  // ground truth: the ideal pinhole depth at the centre of the exposure
+      img.depth_left = renderer.render(poses[k].T_W_C, ns_to_seconds(poses[k].t_ns), true).depth_left;
     render_s += std::chrono::duration<double>(Clock::now() - t0).count();
+    ++delivered;
     const std::string name = fmt::format("{:06d}", k);
     write_png(dir.path() / "left" / (name + ".png"), img.left);
     write_png(dir.path() / "right" / (name + ".png"), img.right);
     if (depth) write_pfm(dir.path() / "depth" / (name + ".pfm"), img.depth_left);
-    times.write(fmt::format("{},{}\n", k, poses[k].t_ns));
+    times.write(fmt::format("{},{}\n", k, k < stamps.size() ? stamps[k].t_stamp_ns : poses[k].t_ns));
   }
   times.commit();
   write_tum(dir.path() / "groundtruth.tum", poses);
   dir.commit();
-  summary.frames = poses.size();
+  summary.frames = delivered;
   summary.render_s = render_s;
-  summary.pairs_per_s = render_s > 0 ? static_cast<double>(poses.size()) / render_s : 0;
+  summary.pairs_per_s = render_s > 0 ? static_cast<double>(delivered) / render_s : 0;
   return summary;
 }
 

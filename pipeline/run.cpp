@@ -15,6 +15,7 @@
 #include "core/yaml_io.hpp"
 #include "eval/evaluate.hpp"
 #include "fusion/ca_smoother.hpp"
+#include "pipeline/camera_stage.hpp"
 #include "pipeline/filter_stage.hpp"
 #include "pipeline/progress.hpp"
 #include "pipeline/render_stage.hpp"
@@ -203,6 +204,7 @@ static sim::SceneGeometry scene_for_track(const Scenario& sc, const Trajectory& 
 
 static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scene,
                               const SensorData& sensor_data, const Trajectory& camera_gt,
+                              const std::vector<FrameTruth>& frame_truth,
                               const std::vector<EulerZYX>& platform,
                               const std::filesystem::path& dir, const RunOptions& options,
                               RunSummary* summary, nlohmann::json* metrics) {
@@ -212,6 +214,11 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   sim::StereoRenderer renderer(rig, sc.render);
   renderer.upload(scene);
   renderer.set_waves(sim::wave_components(sc.water.waves, rng.stream("waves.phases")));
+  CameraStage camera(sc, &renderer, rng);
+  // The camera's clock: stamps (offset, jitter) and dropped frames.
+  const std::vector<sim::SampleTime> stamps =
+      sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
+  DRIFTLAB_DEMAND_MSG(stamps.size() >= camera_gt.size(), "camera clock: fewer stamps than frames");
 
   // Stages: VO and fusion. VO sees images and the rig only; the pipeline
   // anchors every estimate at the true first pose so that tracks overlay.
@@ -247,7 +254,11 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
       tracks.push_back(std::move(t));
     }
   }
-  for (auto& t : tracks) t.estimate.push_back({camera_gt.front().t_ns, camera_gt.front().T_W_C});
+  std::size_t first = 0;  // the first frame the camera delivers
+  while (first < stamps.size() && first < camera_gt.size() && stamps[first].dropped) ++first;
+  if (first < camera_gt.size())
+    for (auto& t : tracks) t.estimate.push_back({stamps[first].t_stamp_ns, camera_gt[first].T_W_C});
+  std::size_t dropped = 0;
 
   AtomicFile frames_csv(dir / "frames.csv");
   std::string header = "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms";
@@ -261,9 +272,13 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   std::filesystem::create_directories(dir / "plots");
   for (std::size_t k = 0; k < camera_gt.size(); ++k) {
     progress.update(k);
-    const TimeNs t = camera_gt[k].t_ns;
+    if (stamps[k].dropped) {  // never delivered: nothing rendered, nothing seen
+      ++dropped;
+      continue;
+    }
+    const TimeNs t = stamps[k].t_stamp_ns;  // what the camera's clock wrote
     const auto t_render = std::chrono::steady_clock::now();
-    const sim::StereoImages img = renderer.render(camera_gt[k].T_W_C, ns_to_seconds(t), false);
+    const sim::StereoImages img = camera.capture(frame_truth[k]);
     const double render_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_render).count();
     render_s += render_ms / 1000;
@@ -292,7 +307,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
                            r.valid ? yaml::format_double(r.mean_inlier_depth_m) : "",
                            r.times.total_ms);
       }
-      if (k == 0) {
+      if (k == first) {
         if (tr.smoother) tr.smoother->update(t, r);  // starts the clock
         if (tr.filter) tr.filter->step(t, r);         // starts from the anchor
         continue;
@@ -377,7 +392,15 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   write_file_atomic(dir / "report.html", report_html("driftlab run: " + sc.name, tables, plots));
   (*metrics)["timing"]["render_s"] = render_s;
   (*metrics)["timing"]["render_pairs_per_s"] =
-      render_s > 0 ? static_cast<double>(camera_gt.size()) / render_s : 0.0;
+      render_s > 0 ? static_cast<double>(camera_gt.size() - dropped) / render_s : 0.0;
+  const auto& cam = sc.sensors.camera;
+  (*metrics)["camera"] = {{"frames_delivered", camera_gt.size() - dropped},
+                          {"frames_dropped", dropped},
+                          {"noise", cam.noise.enabled},
+                          {"vignetting_strength", cam.vignetting_strength},
+                          {"motion_blur_samples", sc.render.motion_blur_samples},
+                          {"lens_distortion", cam.lens_distortion.enabled},
+                          {"clock_offset_ms", cam.clock.offset_ms}};
   (*metrics)["warnings"] = warnings;
   (*metrics)["render"] = {{"context", renderer.context_description()},
                           {"triangles", renderer.triangles()}};
@@ -395,6 +418,7 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
   // Stage: physics: ground truth at the physics rate and at each frame.
   const SE3 T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
   Trajectory camera_gt;
+  std::vector<FrameTruth> frame_truth;  // body pose and twist at each frame (the camera stage)
   std::vector<EulerZYX> platform;  // body attitude at each frame (the IMU's, for covariate h)
   AtomicFile body(dir.path() / "body_groundtruth.csv");
   body.write(body_csv_header());
@@ -404,6 +428,9 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
       sc, [&](const sim::BodySample& b) { body.write(body_csv_row(b)); },
       [&](const sim::BodySample& b) {
         camera_gt.push_back({b.t_ns, b.state.T_W_B() * T_B_C});
+        Vec6 twist;
+        twist << b.state.v_B, b.state.w_B;
+        frame_truth.push_back({ns_to_seconds(b.t_ns), b.state.T_W_B(), twist});
         platform.push_back(euler_zyx_from_quat(b.state.q_W_B));
       },
       sensors.sample_times(motion_end_s(sc)),
@@ -427,8 +454,8 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
 
   const bool run_vo = !options.only_motion && !sc.pipeline.vo.empty() && !camera_gt.empty();
   if (run_vo)
-    run_vision_stages(sc, *scene, sensor_data, camera_gt, platform, dir.path(), options, &summary,
-                      &metrics);
+    run_vision_stages(sc, *scene, sensor_data, camera_gt, frame_truth, platform, dir.path(),
+                      options, &summary, &metrics);
 
   summary.total_s = seconds_since(t0);
   metrics["version"] = DRIFTLAB_VERSION;

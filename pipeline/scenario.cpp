@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -109,6 +110,16 @@ void validate_scenario(const Scenario& s, const std::string& label) {
   if (s.pipeline.vo.empty() && !s.pipeline.fusion.empty())
     errors.add("pipeline.fusion: got filters but no VO to feed them, expected pipeline.vo to "
                "name at least one VO algorithm");
+  // The camera clock's stamps must stay within the association tolerance of
+  // the true frame times, or no estimate would be paired with ground truth.
+  const auto& clock = s.sensors.camera.clock;
+  const double stamp_error_s = (std::abs(clock.offset_ms) + 3 * clock.jitter_ms) * 1e-3;
+  if (!s.pipeline.vo.empty() && stamp_error_s > s.eval.association_tolerance_s)
+    errors.add(fmt::format(
+        "sensors.camera.clock: got offset_ms {} and jitter_ms {}, stamps up to {} s from the "
+        "true frame times, expected at most eval.association_tolerance_s = {} s (raise it, "
+        "below half the frame period, to evaluate a camera with this clock)",
+        clock.offset_ms, clock.jitter_ms, stamp_error_s, s.eval.association_tolerance_s));
   errors.throw_if_any(label + ": invalid scenario:");
 }
 

@@ -18,6 +18,7 @@ struct RenderOptions {
   int msaa_samples = 1;
   bool ground_truth_depth = false;
   bool reflections = true;
+  int motion_blur_samples = 1;
 
   template <class A>
   void visit(A& a) {
@@ -28,6 +29,10 @@ struct RenderOptions {
     a("ground_truth_depth", ground_truth_depth, "Also render per-pixel ground-truth depth");
     a("reflections", reflections,
       "Planar reflection of the scene on the water (one extra geometry pass per eye)");
+    a("motion_blur_samples", motion_blur_samples,
+      "Motion blur: renders averaged over the exposure (sensors.camera.exposure_ms) along the "
+      "true motion; 1 = off, each sample costs one more render",
+      yaml::in_range(1, 64));
   }
 };
 

@@ -325,6 +325,7 @@ Eigen::Matrix4f projection_from_intrinsics(const PinholeCamera& c, float n, floa
 
 struct StereoRenderer::Impl {
   StereoRig rig;
+  SE3 T_left_right;  // the true right camera (defaults to the rig's baseline)
   RenderOptions options;
   std::unique_ptr<GlContext> context;
   // Programs by variant: [mode][sun] with mode 0 gray, 1 linear depth.
@@ -375,6 +376,7 @@ StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& option
   if (!problems.empty()) throw UserError("renderer: invalid stereo rig: " + problems);
   yaml::validate_or_throw(options, "render");
   impl_->rig = rig;
+  impl_->T_left_right = rig.T_left_right();
   impl_->options = options;
   impl_->context = create_gl_context(options.backend);
   for (int mode : {0, 1})
@@ -827,11 +829,15 @@ DepthImage StereoRenderer::Impl::render_depth(const SE3& T_W_C, double t) {
   return d;
 }
 
+void StereoRenderer::set_right_camera(const SE3& T_left_right) {
+  impl_->T_left_right = T_left_right;
+}
+
 StereoImages StereoRenderer::render(const SE3& T_W_C_left, double t_s, bool with_depth) {
   impl_->context->make_current();
   StereoImages out;
   impl_->draw_eye(T_W_C_left, t_s, 0);
-  impl_->draw_eye(T_W_C_left * impl_->rig.T_left_right(), t_s, 1);
+  impl_->draw_eye(T_W_C_left * impl_->T_left_right, t_s, 1);
   if (with_depth) out.depth_left = impl_->render_depth(T_W_C_left, t_s);
   out.left = impl_->read_eye(0);
   out.right = impl_->read_eye(1);

@@ -65,6 +65,9 @@ class StereoRenderer {
   void upload(const SceneGeometry& scene);
   /// The wave components the water surface shows (calm when empty).
   void set_waves(const std::vector<WaveComponent>& components);
+  /// Where the right camera really is relative to the left (a miscalibrated
+  /// rig: see sim::true_T_left_right); the rig's nominal baseline by default.
+  void set_right_camera(const SE3& T_left_right);
   /// Renders the pair at left-camera pose T_W_C (world NED <- optical) and time t_s.
   StereoImages render(const SE3& T_W_C_left, double t_s, bool with_depth);
 

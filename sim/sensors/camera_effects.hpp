@@ -17,10 +17,9 @@
 // pinhole model, s = vignetting_strength (the cos^4 law of natural illumination
 // fall-off, e.g. Hecht, "Optics").
 //
-// Not modelled here: motion blur and lens distortion, which need the renderer
-// (blur integrates the scene over the exposure; distortion remaps rays before
-// rasterisation, and re-sampling a rendered image would blur and crop it);
-// rolling shutter, for the same reason.
+// Elsewhere: motion blur (sub-frame renders, pipeline/camera_stage.hpp) and
+// lens distortion with rectification (sim/sensors/lens.hpp). Not modelled:
+// rolling shutter.
 #pragma once
 
 #include <opencv2/core.hpp>

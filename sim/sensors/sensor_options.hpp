@@ -104,6 +104,29 @@ struct StereoCalibrationErrorOptions {
   }
 };
 
+/// Lens distortion of both cameras (Brown-Conrady, OpenCV's order k1, k2, p1,
+/// p2, k3 on normalised coordinates) and the rectification that removes it
+/// again with the calibrated coefficients (true + calibration_error), so that
+/// the stream the VO sees is rectified but resampled twice and, with a
+/// calibration error, carries residual distortion.
+struct LensDistortionOptions {
+  bool enabled = false;
+  std::array<double, 5> coefficients{-0.30, 0.10, 0.0, 0.0, 0.0};
+  std::array<double, 5> calibration_error{0.0, 0.0, 0.0, 0.0, 0.0};
+
+  template <class A>
+  void visit(A& a) {
+    a("enabled", enabled, "Distort the rendered images and rectify them again (OpenCV remap)");
+    a("coefficients", coefficients,
+      "True lens distortion k1, k2, p1, p2, k3 (OpenCV order; the default is a Bumblebee2-like "
+      "wide lens)",
+      yaml::in_range(-2, 2));
+    a("calibration_error", calibration_error,
+      "Calibrated minus true coefficients, k1..k3: the rectification uses true + error",
+      yaml::in_range(-1, 1));
+  }
+};
+
 /// Rectified pinhole stereo camera (river paper Eq. (1) uses fx, cx, cy and the baseline).
 struct CameraOptions {
   int width_px = 640;
@@ -119,6 +142,7 @@ struct CameraOptions {
   CameraNoiseOptions noise;
   double vignetting_strength = 0.0;
   StereoCalibrationErrorOptions calibration_error;
+  LensDistortionOptions lens_distortion;
   ClockOptions clock;
 
   template <class A>
@@ -145,6 +169,7 @@ struct CameraOptions {
       "Blend of cos^4 vignetting: 0 = none, 1 = the full cos^4 law of the pinhole's field angle",
       yaml::unit_interval());
     a("calibration_error", calibration_error, "Stereo miscalibration (true rig vs nominal)");
+    a("lens_distortion", lens_distortion, "Lens distortion and rectification of both images");
     a.require(baseline_m + calibration_error.baseline_error_m > 0, "calibration_error",
               "a true baseline (baseline_m + baseline_error_m) > 0");
     a("clock", clock, "Frame time stamps: offset, jitter, dropped frames");

@@ -1,0 +1,80 @@
+#include "pipeline/camera_stage.hpp"
+
+#include <opencv2/core.hpp>
+
+#include <vector>
+
+#include "core/error.hpp"
+#include "pipeline/run.hpp"
+
+namespace driftlab::pipeline {
+namespace {
+
+cv::Mat as_mat(sim::GrayImage* img) {
+  return cv::Mat(img->height, img->width, CV_8UC1, img->pixels.data());
+}
+
+}  // namespace
+
+CameraStage::CameraStage(const Scenario& sc, sim::StereoRenderer* renderer, const RngStreams& rng)
+    : renderer_(renderer),
+      T_B_C_(camera_mount_T_B_C(sc.sensors.camera.mount)),
+      blur_samples_(sc.render.motion_blur_samples),
+      exposure_s_(sc.sensors.camera.exposure_ms * 1e-3),
+      left_noise_(sc.sensors.camera, rng, "camera.left"),
+      right_noise_(sc.sensors.camera, rng, "camera.right") {
+  DRIFTLAB_DEMAND(renderer_ != nullptr);
+  renderer_->set_right_camera(sim::true_T_left_right(sc.sensors.camera));
+  if (sc.sensors.camera.lens_distortion.enabled) lens_.emplace(sc.sensors.camera);
+}
+
+sim::StereoImages CameraStage::render_blurred(const FrameTruth& truth) {
+  if (blur_samples_ <= 1 || exposure_s_ <= 0)
+    return renderer_->render(T_W_C(truth), truth.t_s, false);
+  // Sub-frame instants at the centres of blur_samples_ equal parts of the exposure.
+  std::vector<std::uint32_t> sum_left, sum_right;
+  sim::StereoImages out;
+  for (int s = 0; s < blur_samples_; ++s) {
+    const double d = ((s + 0.5) / blur_samples_ - 0.5) * exposure_s_;
+    const SE3 T_W_B = truth.T_W_B * SE3::exp(truth.twist_B * d);
+    sim::StereoImages img = renderer_->render(T_W_B * T_B_C_, truth.t_s + d, false);
+    if (s == 0) {
+      sum_left.assign(img.left.pixels.size(), 0);
+      sum_right.assign(img.right.pixels.size(), 0);
+      out = std::move(img);
+      for (std::size_t i = 0; i < sum_left.size(); ++i) sum_left[i] = out.left.pixels[i];
+      for (std::size_t i = 0; i < sum_right.size(); ++i) sum_right[i] = out.right.pixels[i];
+      continue;
+    }
+    for (std::size_t i = 0; i < sum_left.size(); ++i) sum_left[i] += img.left.pixels[i];
+    for (std::size_t i = 0; i < sum_right.size(); ++i) sum_right[i] += img.right.pixels[i];
+  }
+  // Rounded mean (integer arithmetic: the same bytes on every machine).
+  const auto n = static_cast<std::uint32_t>(blur_samples_);
+  for (std::size_t i = 0; i < sum_left.size(); ++i)
+    out.left.pixels[i] = static_cast<std::uint8_t>((sum_left[i] + n / 2) / n);
+  for (std::size_t i = 0; i < sum_right.size(); ++i)
+    out.right.pixels[i] = static_cast<std::uint8_t>((sum_right[i] + n / 2) / n);
+  return out;
+}
+
+sim::StereoImages CameraStage::capture(const FrameTruth& truth) {
+  sim::StereoImages img = render_blurred(truth);
+  cv::Mat left = as_mat(&img.left), right = as_mat(&img.right);
+  if (lens_) {
+    lens_->distort(&left);
+    lens_->distort(&right);
+  }
+  left_noise_.apply(&left);
+  right_noise_.apply(&right);
+  if (lens_) {
+    lens_->rectify(&left);
+    lens_->rectify(&right);
+    // The remaps may have given the matrices new buffers.
+    if (left.data != img.left.pixels.data()) left.copyTo(as_mat(&img.left));
+    if (right.data != img.right.pixels.data()) right.copyTo(as_mat(&img.right));
+  }
+  return img;
+}
+
+}  // namespace driftlab::pipeline
