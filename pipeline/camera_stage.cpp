@@ -2,6 +2,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <future>
 #include <vector>
 
 #include "core/error.hpp"
@@ -60,20 +61,20 @@ sim::StereoImages CameraStage::render_blurred(const FrameTruth& truth) {
 
 sim::StereoImages CameraStage::capture(const FrameTruth& truth) {
   sim::StereoImages img = render_blurred(truth);
-  cv::Mat left = as_mat(&img.left), right = as_mat(&img.right);
-  if (lens_) {
-    lens_->distort(&left);
-    lens_->distort(&right);
-  }
-  left_noise_.apply(&left);
-  right_noise_.apply(&right);
-  if (lens_) {
-    lens_->rectify(&left);
-    lens_->rectify(&right);
-    // The remaps may have given the matrices new buffers.
-    if (left.data != img.left.pixels.data()) left.copyTo(as_mat(&img.left));
-    if (right.data != img.right.pixels.data()) right.copyTo(as_mat(&img.right));
-  }
+  // Lens and noise of the two cameras are independent (separate streams):
+  // the left one runs on a second thread, the bytes are the same either way.
+  auto process = [this](sim::GrayImage* gray, sim::CameraImageNoise* noise) {
+    cv::Mat m = as_mat(gray);
+    if (lens_) lens_->distort(&m);
+    noise->apply(&m);
+    if (lens_) {
+      lens_->rectify(&m);
+      if (m.data != gray->pixels.data()) m.copyTo(as_mat(gray));  // a remap may reallocate
+    }
+  };
+  auto left = std::async(std::launch::async, process, &img.left, &left_noise_);
+  process(&img.right, &right_noise_);
+  left.get();
   return img;
 }
 

@@ -1,5 +1,6 @@
 #include "sim/sensors/camera_effects.hpp"
 
+#include <boost/math/distributions/normal.hpp>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -11,6 +12,33 @@
 #include "sim/vessel/simulator.hpp"
 
 namespace driftlab::sim {
+namespace {
+
+// Image noise needs about 600 000 normal variates per stereo pair, and the
+// polar method (Rng::normal) costs ~30 ns each. Here a normal variate comes
+// from 16 random bits instead (four per 64-bit draw): the index of one of 2^16
+// equally probable cells, whose value is the standard normal quantile at the
+// cell's centre (i + 1/2) / 2^16 (Boost.Math). This is the standard normal
+// quantised to 2^16 cells: variance 0.9996, tails cut at 4.3 sigma, far finer
+// than the rounding to whole DN that follows.
+const std::array<float, 65536>& normal_quantiles() {
+  static const std::array<float, 65536> table = [] {
+    std::array<float, 65536> t{};
+    const boost::math::normal_distribution<double> n(0.0, 1.0);
+    for (std::size_t i = 0; i < t.size(); ++i)
+      t[i] = static_cast<float>(boost::math::quantile(n, (static_cast<double>(i) + 0.5) / 65536.0));
+    return t;
+  }();
+  return table;
+}
+
+}  // namespace
+
+double image_noise_normal_variance() {
+  double v = 0;
+  for (float z : normal_quantiles()) v += static_cast<double>(z) * z;
+  return v / 65536.0;
+}
 
 PhotometricModel::PhotometricModel(const CameraOptions& camera)
     // Validated before any member uses a field (members initialise in order).
@@ -60,6 +88,9 @@ void PhotometricModel::apply(cv::Mat* image, Rng* rng) const {
     mean_lut[v] = v * signal_scale_;
     sd_lut[v] = k * std::sqrt(mean_lut[v] / k + read_var_e2_);
   }
+  const auto& z = normal_quantiles();
+  std::uint64_t bits = 0;
+  int left_in_bits = 0;  // 16-bit variates left in `bits`
   std::size_t i = 0;
   for (int y = 0; y < image->rows; ++y) {
     auto* row = image->ptr<std::uint8_t>(y);
@@ -75,7 +106,16 @@ void PhotometricModel::apply(cv::Mat* image, Rng* rng) const {
       }
       // Shot and read noise are independent Gaussians: one draw of their
       // combined standard deviation K sqrt(mu_e + sigma_r^2).
-      const double out = noisy ? mean + sd * rng->normal() : mean;
+      double out = mean;
+      if (noisy) {
+        if (left_in_bits == 0) {
+          bits = rng->next_u64();
+          left_in_bits = 4;
+        }
+        out += sd * z[bits & 0xFFFFu];
+        bits >>= 16;
+        --left_in_bits;
+      }
       row[x] = static_cast<std::uint8_t>(std::clamp(std::nearbyint(out), 0.0, 255.0));
     }
   }

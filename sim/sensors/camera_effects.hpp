@@ -55,8 +55,10 @@ class PhotometricModel {
   double noise_variance_dn2(double mean_dn) const;
 
   /// Applies gain, exposure, vignetting and (when enabled) noise to `image` in
-  /// place, drawing one normal per pixel in row-major order from `rng`. The
-  /// image must be CV_8UC1 of width_px x height_px (UserError otherwise).
+  /// place, one normal variate per pixel in row-major order, four per 64-bit
+  /// draw from `rng` (a 2^16-cell quantised normal, see
+  /// image_noise_normal_variance). The image must be CV_8UC1 of width_px x
+  /// height_px (UserError otherwise).
   void apply(cv::Mat* image, Rng* rng) const;
 
   const CameraOptions& options() const { return options_; }
@@ -68,6 +70,10 @@ class PhotometricModel {
   double read_var_e2_;
   std::vector<float> vignetting_;  // row-major V(x, y); empty when strength is 0
 };
+
+/// Variance of the quantised standard normal the image noise draws from
+/// (0.9996: 2^16 equally probable cells at their centre quantiles).
+double image_noise_normal_variance();
 
 /// One camera's photometric effects with its own stream (NAME.noise, e.g.
 /// "camera.left.noise"), so that left and right noise are independent and

@@ -201,3 +201,20 @@ TEST(CameraSensor, ImagesAreReproducibleAndLeftRightIndependent) {
 
 }  // namespace
 }  // namespace driftlab::sim
+
+namespace driftlab::sim {
+namespace {
+
+// The quantised normal behind the image noise: 2^16 equally probable cells,
+// so its variance is 1 minus the within-cell variance and the cut tails
+// (about 4e-4, computed here from the normal density: the cells' spread is
+// negligible but in the two outermost cells, which hold the tails beyond
+// 4.3 sigma).
+TEST(CameraSensor, QuantisedNormalOfTheImageNoiseHasUnitVariance) {
+  const double v = image_noise_normal_variance();
+  EXPECT_GT(v, 0.999);
+  EXPECT_LT(v, 1.0);
+}
+
+}  // namespace
+}  // namespace driftlab::sim
