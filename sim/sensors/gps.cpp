@@ -39,7 +39,57 @@ Constellation::Constellation(int size, double period_s, double latitude_deg, Rng
   axis_ned_ = Vec3(std::cos(lat), 0.0, -std::sin(lat));  // north celestial pole at elevation = lat
 }
 
+Constellation Constellation::orbits(int size, double period_s, double latitude_deg,
+                                    double longitude_deg, Rng rng) {
+  DRIFTLAB_DEMAND(size >= 1);
+  constexpr int kPlanes = 6;
+  constexpr double kInclination = 55.0 * std::numbers::pi / 180.0;
+  const double two_pi = 2.0 * std::numbers::pi;
+  Constellation c;
+  c.period_s_ = period_s;
+  // Random orientation of the pattern: node offset, slot offset, Earth angle.
+  const double node0 = rng.uniform(0.0, two_pi), u00 = rng.uniform(0.0, two_pi);
+  c.earth_angle0_rad_ = rng.uniform(0.0, two_pi);
+  for (int k = 0; k < size; ++k) {
+    const int plane = k % kPlanes, slot = k / kPlanes;
+    const int per_plane = (size - plane + kPlanes - 1) / kPlanes;  // slots in this plane
+    Orbit o;
+    o.node_rad = node0 + two_pi * plane / kPlanes;
+    o.inclination_rad = kInclination;
+    o.u0_rad = u00 + two_pi * slot / per_plane + two_pi * plane / size;  // Walker phasing F = 1
+    c.orbits_.push_back(o);
+  }
+  const double lat = deg2rad(latitude_deg), lon = deg2rad(longitude_deg);
+  c.receiver_ecef_m_ = kEarthRadius_m * Vec3(std::cos(lat) * std::cos(lon),
+                                             std::cos(lat) * std::sin(lon), std::sin(lat));
+  // Rows: north, east, down in ECEF.
+  c.R_ned_ecef_ << -std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat),
+      -std::sin(lon), std::cos(lon), 0.0,
+      -std::cos(lat) * std::cos(lon), -std::cos(lat) * std::sin(lon), -std::sin(lat);
+  return c;
+}
+
 std::vector<Vec3> Constellation::directions_ned(double t_s) const {
+  if (!orbits_.empty()) {
+    // Circular orbits in the inertial frame, then into the Earth-fixed frame
+    // turned by the Earth's rotation since t = 0.
+    const double n = period_s_ > 0 ? 2.0 * std::numbers::pi / period_s_ : 0.0;
+    // period 0: a fixed sky (satellites and Earth both still).
+    const double theta = earth_angle0_rad_ + (period_s_ > 0 ? kEarthSiderealRate_rad_s * t_s : 0.0);
+    std::vector<Vec3> out;
+    out.reserve(orbits_.size());
+    for (const Orbit& o : orbits_) {
+      const double u = o.u0_rad + n * t_s;
+      const double cu = std::cos(u), su = std::sin(u), cO = std::cos(o.node_rad),
+                   sO = std::sin(o.node_rad), ci = std::cos(o.inclination_rad),
+                   si = std::sin(o.inclination_rad);
+      const Vec3 eci = kGpsOrbitRadius_m * Vec3(cO * cu - sO * su * ci, sO * cu + cO * su * ci, su * si);
+      const Vec3 ecef(std::cos(theta) * eci.x() + std::sin(theta) * eci.y(),
+                      -std::sin(theta) * eci.x() + std::cos(theta) * eci.y(), eci.z());
+      out.push_back((R_ned_ecef_ * (ecef - receiver_ecef_m_)).normalized());
+    }
+    return out;
+  }
   if (period_s_ <= 0) return base_;
   // The Earth turns east about the polar axis, so the sky turns west: a
   // negative angle about the axis pointing at the celestial pole.
@@ -83,8 +133,15 @@ GpsSimulator::GpsSimulator(const GpsOptions& options, const RngStreams& rng,
     : options_((validate_sensor_options(options, "sensors." + name), options)),
       sky_(sky ? sky : &open_sky_),
       plane_({options.datum_lat_lon_h[0], options.datum_lat_lon_h[1], options.datum_lat_lon_h[2]}),
-      constellation_(options.constellation_size, options.constellation_period_s,
-                     options.datum_lat_lon_h[0], rng.stream(name + ".constellation")),
+      constellation_(options.constellation == ConstellationModel::kOrbits
+                         ? Constellation::orbits(options.constellation_size,
+                                                 options.constellation_period_s,
+                                                 options.datum_lat_lon_h[0],
+                                                 options.datum_lat_lon_h[1],
+                                                 rng.stream(name + ".constellation"))
+                         : Constellation(options.constellation_size, options.constellation_period_s,
+                                         options.datum_lat_lon_h[0],
+                                         rng.stream(name + ".constellation"))),
       noise_(rng.stream(name + ".noise")),
       clock_(options.clock, rng, name),
       antenna_B_(options.antenna_frd_m[0], options.antenna_frd_m[1], options.antenna_frd_m[2]) {}

@@ -27,6 +27,9 @@
 namespace driftlab::sim {
 
 inline constexpr double kGpsNaN = std::numeric_limits<double>::quiet_NaN();
+inline constexpr double kGpsOrbitRadius_m = 26'559'700.0;  // semi-major axis of GPS orbits
+inline constexpr double kEarthRadius_m = 6'371'000.0;      // mean radius (spherical Earth)
+inline constexpr double kEarthSiderealRate_rad_s = 7.2921151467e-5;  // WGS84
 
 /// A deterministic synthetic constellation: `size` satellites spread evenly over
 /// the whole sky sphere (a Fibonacci lattice, so that no seed leaves a hole),
@@ -36,15 +39,36 @@ inline constexpr double kGpsNaN = std::numeric_limits<double>::quiet_NaN();
 class Constellation {
  public:
   Constellation(int size, double period_s, double latitude_deg, Rng rng);
+  /// GPS-like orbits: `size` satellites on circular orbits of radius
+  /// kGpsOrbitRadius_m in 6 planes at 55 deg inclination, ascending nodes 60 deg
+  /// apart, slots evenly spaced in each plane with a 360 / size deg phase step
+  /// between neighbouring planes (a Walker delta constellation size/6/1, the
+  /// layout of GPS's nominal 24 slots, ICD-GPS-200 / Spilker 1996), orbital
+  /// period `period_s`, the whole pattern turned by random angles from `rng`.
+  /// Seen from the receiver at (lat, lon) on a spherical Earth that turns at
+  /// the sidereal rate: above 52 deg N no satellite rises near the north
+  /// celestial pole, so the northern sky is emptier than the southern.
+  static Constellation orbits(int size, double period_s, double latitude_deg,
+                              double longitude_deg, Rng rng);
 
   /// Unit vectors from the receiver towards each satellite at `t_s`, world NED.
   std::vector<Vec3> directions_ned(double t_s) const;
-  int size() const { return static_cast<int>(base_.size()); }
+  int size() const { return static_cast<int>(orbits_.empty() ? base_.size() : orbits_.size()); }
 
  private:
-  std::vector<Vec3> base_;  // directions at t = 0, NED
+  Constellation() = default;
+  std::vector<Vec3> base_;  // directions at t = 0, NED (sphere model)
   Vec3 axis_ned_;           // towards the celestial pole
-  double period_s_;
+  double period_s_ = 0;
+  // Orbits model: per satellite, the plane's ascending node and inclination
+  // and the argument of latitude at t = 0 [rad]; empty for the sphere model.
+  struct Orbit {
+    double node_rad = 0, inclination_rad = 0, u0_rad = 0;
+  };
+  std::vector<Orbit> orbits_;
+  double earth_angle0_rad_ = 0;
+  Vec3 receiver_ecef_m_ = Vec3::Zero();
+  Mat3 R_ned_ecef_ = Mat3::Identity();
 };
 
 /// Elevation [rad] of a unit direction in NED (positive above the horizon).

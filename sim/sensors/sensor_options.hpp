@@ -183,6 +183,15 @@ struct CameraOptions {
 inline constexpr double kImuDegToRad = std::numbers::pi / 180.0;
 inline constexpr double kImuStandardGravity_m_s2 = 9.80665;
 
+/// How GPS satellites are placed: on GPS-like circular orbits (a Walker
+/// 24/6/1 constellation at 55 deg inclination seen from the datum), or spread
+/// evenly over the whole sky sphere (no orbital holes; for tests).
+enum class ConstellationModel { kOrbits, kSphere };
+constexpr auto enum_table(ConstellationModel) {
+  return std::array{std::pair{ConstellationModel::kOrbits, "orbits"},
+                    std::pair{ConstellationModel::kSphere, "sphere"}};
+}
+
 enum class ImuPreset { kIdeal, kMpu9250, kAdis16448 };
 constexpr auto enum_table(ImuPreset) {
   return std::array{std::pair{ImuPreset::kIdeal, "ideal"}, std::pair{ImuPreset::kMpu9250, "mpu9250"},
@@ -360,7 +369,8 @@ struct GpsOptions {
   std::array<double, 3> datum_lat_lon_h{52.1357, -0.4665, 20.0};
   int min_satellites = 4;
   std::array<double, 3> antenna_frd_m{0.0, 0.0, -1.0};
-  int constellation_size = 24;
+  ConstellationModel constellation = ConstellationModel::kOrbits;
+  int constellation_size = 31;
   double elevation_mask_deg = 10.0;
   double max_hdop = 20.0;
   double constellation_period_s = 43082.0;
@@ -393,10 +403,13 @@ struct GpsOptions {
       yaml::in_range(4, 64));
     a("antenna_frd_m", antenna_frd_m,
       "Antenna phase centre from the centre of gravity, body FRD [m]");
+    a("constellation", constellation,
+      "orbits: GPS-like circular orbits (6 planes at 55 deg inclination, 26 560 km, half a "
+      "sidereal day) seen from datum_lat_lon_h, with the sky's real holes (none near the "
+      "celestial pole at high latitudes); sphere: spread evenly over the sky sphere");
     a("constellation_size", constellation_size,
-      "Satellites of the synthetic constellation, spread evenly over the whole sky sphere; a "
-      "fraction (1 - sin(mask)) / 2 is above the mask (24: GPS's nominal slots, about 10 "
-      "above 10 deg)",
+      "Satellites of the synthetic constellation (orbits: spread over 6 planes; 31 = GPS's "
+      "operational count, 24 its nominal slots)",
       yaml::in_range(4, 200));
     a.require(constellation_size >= min_satellites, "constellation_size",
               "at least min_satellites satellites");
@@ -406,8 +419,8 @@ struct GpsOptions {
       yaml::non_negative());
     a.require(max_hdop == 0 || max_hdop >= 1, "max_hdop", "0 (no limit) or a value >= 1");
     a("constellation_period_s", constellation_period_s,
-      "Period of the sky's slow rotation about the Earth's axis (GPS: half a sidereal day; 0 "
-      "= a fixed sky) [s]",
+      "orbits: orbital period (GPS: half a sidereal day), the Earth turning under them; "
+      "sphere: period of the sky's rotation about the Earth's axis; 0 = a fixed sky [s]",
       yaml::non_negative());
     a("error_correlation_time_s", error_correlation_time_s,
       "Correlation time of the position error, first-order Gauss-Markov (0 = white, "

@@ -107,6 +107,7 @@ TEST(GpsSensor, RayCastsAgainstBoxesAndTriangles) {
 
 TEST(GpsSensor, OpenSkyNeverLosesTheFix) {
   GpsOptions o;
+  o.constellation = ConstellationModel::kSphere;  // evenly spread: no orbital holes
   GpsSimulator gps(o, RngStreams(1));
   int outages = 0, min_sats = 100;
   double max_hdop = 0;
@@ -122,6 +123,36 @@ TEST(GpsSensor, OpenSkyNeverLosesTheFix) {
   EXPECT_EQ(outages, 0);
   EXPECT_GE(min_sats, 8);
   EXPECT_LT(max_hdop, 2.0);
+}
+
+// The orbit model seen from 52 deg N: satellites on 55 deg inclined orbits
+// never pass north of 55 deg latitude, so the northern sky below ~85 deg of
+// elevation stays empty (a satellite due north at elevation e would sit at a
+// latitude 52 + 90 - e - asin(R cos e / a) deg, beyond 55 for every e < 85);
+// the southern sky is full. Open sky still keeps a fix with the 31 satellites.
+TEST(GpsSensor, OrbitsLeaveTheNorthernHoleAndKeepAFixInOpenSky) {
+  GpsOptions o;
+  ASSERT_EQ(o.constellation, ConstellationModel::kOrbits);
+  GpsSimulator gps(o, RngStreams(1));
+  int north = 0, south = 0, min_visible = 100;
+  for (int k = 0; k < 24 * 60; ++k) {  // a day, every minute
+    const auto dirs = gps.constellation().directions_ned(60.0 * k);
+    int visible = 0;
+    for (const Vec3& u : dirs) {
+      const double el = elevation_rad(u) * 180 / std::numbers::pi;
+      const double az = std::atan2(u.y(), u.x()) * 180 / std::numbers::pi;  // from north, east +
+      if (el < 10) continue;
+      ++visible;
+      if (std::abs(az) < 10 && el < 80) ++north;
+      if (std::abs(std::abs(az) - 180) < 10 && el < 80) ++south;
+    }
+    min_visible = std::min(min_visible, visible);
+  }
+  std::printf("orbits from 52 N, a day: %d sightings due north, %d due south, at least %d above 10 deg\n",
+              north, south, min_visible);
+  EXPECT_EQ(north, 0);
+  EXPECT_GT(south, 100);
+  EXPECT_GE(min_visible, 5);
 }
 
 TEST(GpsSensor, ReportedHdopMatchesTheVisibleGeometryComputedHere) {
