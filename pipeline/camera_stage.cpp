@@ -2,6 +2,8 @@
 
 #include <opencv2/core.hpp>
 
+#include <algorithm>
+#include <cstdint>
 #include <future>
 #include <vector>
 
@@ -21,22 +23,27 @@ CameraStage::CameraStage(const Scenario& sc, sim::StereoRenderer* renderer, cons
     : renderer_(renderer),
       T_B_C_(camera_mount_T_B_C(sc.sensors.camera.mount)),
       blur_samples_(sc.render.motion_blur_samples),
-      exposure_s_(sc.sensors.camera.exposure_ms * 1e-3),
+      exposure_ms_(sc.sensors.camera.exposure_ms),
+      auto_exposure_(sc.sensors.camera.auto_exposure),
       left_noise_(sc.sensors.camera, rng, "camera.left"),
       right_noise_(sc.sensors.camera, rng, "camera.right") {
   DRIFTLAB_DEMAND(renderer_ != nullptr);
   renderer_->set_right_camera(sim::true_T_left_right(sc.sensors.camera));
   if (sc.sensors.camera.lens_distortion.enabled) lens_.emplace(sc.sensors.camera);
+  if (auto_exposure_.enabled)
+    exposure_ms_ = std::clamp(exposure_ms_, auto_exposure_.min_exposure_ms,
+                              auto_exposure_.max_exposure_ms);
 }
 
 sim::StereoImages CameraStage::render_blurred(const FrameTruth& truth) {
-  if (blur_samples_ <= 1 || exposure_s_ <= 0)
+  const double exposure_s = exposure_ms_ * 1e-3;
+  if (blur_samples_ <= 1 || exposure_s <= 0)
     return renderer_->render(T_W_C(truth), truth.t_s, false);
   // Sub-frame instants at the centres of blur_samples_ equal parts of the exposure.
   std::vector<std::uint32_t> sum_left, sum_right;
   sim::StereoImages out;
   for (int s = 0; s < blur_samples_; ++s) {
-    const double d = ((s + 0.5) / blur_samples_ - 0.5) * exposure_s_;
+    const double d = ((s + 0.5) / blur_samples_ - 0.5) * exposure_s;
     const SE3 T_W_B = truth.T_W_B * SE3::exp(truth.twist_B * d);
     sim::StereoImages img = renderer_->render(T_W_B * T_B_C_, truth.t_s + d, false);
     if (s == 0) {
@@ -66,7 +73,7 @@ sim::StereoImages CameraStage::capture(const FrameTruth& truth) {
   auto process = [this](sim::GrayImage* gray, sim::CameraImageNoise* noise) {
     cv::Mat m = as_mat(gray);
     if (lens_) lens_->distort(&m);
-    noise->apply(&m);
+    noise->apply(&m, exposure_ms_);
     if (lens_) {
       lens_->rectify(&m);
       if (m.data != gray->pixels.data()) m.copyTo(as_mat(gray));  // a remap may reallocate
@@ -75,6 +82,13 @@ sim::StereoImages CameraStage::capture(const FrameTruth& truth) {
   auto left = std::async(std::launch::async, process, &img.left, &left_noise_);
   process(&img.right, &right_noise_);
   left.get();
+  if (auto_exposure_.enabled) {
+    std::uint64_t sum = 0;  // integer sum: the same mean on every machine
+    for (std::uint8_t v : img.left.pixels) sum += v;
+    exposure_ms_ = sim::next_auto_exposure_ms(
+        auto_exposure_, exposure_ms_,
+        static_cast<double>(sum) / static_cast<double>(img.left.pixels.size()));
+  }
   return img;
 }
 

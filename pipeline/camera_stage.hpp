@@ -12,7 +12,9 @@
 //  3. lens distortion (sensors.camera.lens_distortion): the raw image;
 //  4. vignetting, gain, exposure, shot and read noise on the raw image
 //     (sim::PhotometricModel), left and right from separate streams;
-//  5. rectification with the calibrated lens coefficients.
+//  5. rectification with the calibrated lens coefficients;
+//  6. with auto exposure, the next frame's exposure from this left image's
+//     mean (sim::next_auto_exposure_ms); it also sets the blur's duration.
 // Frame timing (clock offset, jitter, dropped frames) is applied by the
 // caller with sim::camera_frame_times.
 #pragma once
@@ -42,6 +44,8 @@ class CameraStage {
   CameraStage(const Scenario& sc, sim::StereoRenderer* renderer, const RngStreams& rng);
   /// Renders and processes one stereo pair (8-bit grayscale, rectified).
   sim::StereoImages capture(const FrameTruth& truth);
+  /// The exposure of the next frame [ms] (changes frame to frame with auto exposure).
+  double exposure_ms() const { return exposure_ms_; }
   /// Left-camera pose at the centre of the exposure.
   SE3 T_W_C(const FrameTruth& truth) const { return truth.T_W_B * T_B_C_; }
 
@@ -51,7 +55,8 @@ class CameraStage {
   sim::StereoRenderer* renderer_;
   SE3 T_B_C_;
   int blur_samples_;
-  double exposure_s_;
+  double exposure_ms_;
+  sim::AutoExposureOptions auto_exposure_;
   sim::CameraImageNoise left_noise_, right_noise_;
   std::optional<sim::LensRoundTrip> lens_;
 };

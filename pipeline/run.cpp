@@ -261,7 +261,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   std::size_t dropped = 0;
 
   AtomicFile frames_csv(dir / "frames.csv");
-  std::string header = "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms";
+  std::string header = "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms,exposure_ms";
   for (std::size_t i = 0; i < n_vo; ++i)
     header += fmt::format(",{0}_valid,{0}_inliers,{0}_valid_depth_px,{0}_mean_depth_m,{0}_ms",
                           tracks[i].name);
@@ -278,6 +278,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
     }
     const TimeNs t = stamps[k].t_stamp_ns;  // what the camera's clock wrote
     const auto t_render = std::chrono::steady_clock::now();
+    const double exposure_ms = camera.exposure_ms();  // this frame's (auto exposure)
     const sim::StereoImages img = camera.capture(frame_truth[k]);
     const double render_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_render).count();
@@ -288,9 +289,9 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
                          const_cast<std::uint8_t*>(img.left.pixels.data()));
     frame.right = cv::Mat(img.right.height, img.right.width, CV_8UC1,
                           const_cast<std::uint8_t*>(img.right.pixels.data()));
-    std::string row = fmt::format("{},{},{},{},{:.3f}", t, rad2deg(platform[k].yaw_rad),
+    std::string row = fmt::format("{},{},{},{},{:.3f},{}", t, rad2deg(platform[k].yaw_rad),
                                   rad2deg(platform[k].pitch_rad), rad2deg(platform[k].roll_rad),
-                                  render_ms);
+                                  render_ms, yaml::format_double(exposure_ms));
     for (std::size_t i = 0; i < tracks.size(); ++i) {
       Track& tr = tracks[i];
       const vo::VoResult r =

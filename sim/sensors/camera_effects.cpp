@@ -72,7 +72,20 @@ double PhotometricModel::noise_variance_dn2(double mean_dn) const {
   return k * mean_dn + k * k * read_var_e2_ + 1.0 / 12.0;
 }
 
-void PhotometricModel::apply(cv::Mat* image, Rng* rng) const {
+double next_auto_exposure_ms(const AutoExposureOptions& o, double exposure_ms,
+                             double image_mean_dn) {
+  // The image mean is proportional to the exposure away from clipping: the
+  // exposure that hits the target is exposure * target / mean. A saturated or
+  // black image gives a mean that understates the step; the loop still moves
+  // the right way and gets there over frames.
+  const double mean = std::max(image_mean_dn, 0.5);
+  const double wanted = exposure_ms * o.target_mean_dn / mean;
+  const double next = std::exp(std::log(exposure_ms) +
+                               o.response * (std::log(wanted) - std::log(exposure_ms)));
+  return std::clamp(next, o.min_exposure_ms, o.max_exposure_ms);
+}
+
+void PhotometricModel::apply(cv::Mat* image, Rng* rng, double exposure_ms) const {
   DRIFTLAB_DEMAND(image != nullptr && rng != nullptr);
   if (image->type() != CV_8UC1 || image->cols != options_.width_px ||
       image->rows != options_.height_px)
@@ -83,9 +96,11 @@ void PhotometricModel::apply(cv::Mat* image, Rng* rng) const {
   const bool noisy = options_.noise.enabled;
   const double k = gain_dn_per_e_;
   // Without vignetting the mean and noise depend on the input value only.
+  const double scale =
+      options_.noise.analog_gain * exposure_ms / options_.noise.reference_exposure_ms;
   std::array<double, 256> mean_lut{}, sd_lut{};
   for (int v = 0; v < 256; ++v) {
-    mean_lut[v] = v * signal_scale_;
+    mean_lut[v] = v * scale;
     sd_lut[v] = k * std::sqrt(mean_lut[v] / k + read_var_e2_);
   }
   const auto& z = normal_quantiles();

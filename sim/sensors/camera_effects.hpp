@@ -59,7 +59,9 @@ class PhotometricModel {
   /// draw from `rng` (a 2^16-cell quantised normal, see
   /// image_noise_normal_variance). The image must be CV_8UC1 of width_px x
   /// height_px (UserError otherwise).
-  void apply(cv::Mat* image, Rng* rng) const;
+  void apply(cv::Mat* image, Rng* rng) const { apply(image, rng, options_.exposure_ms); }
+  /// The same at another exposure (auto exposure) [ms].
+  void apply(cv::Mat* image, Rng* rng, double exposure_ms) const;
 
   const CameraOptions& options() const { return options_; }
 
@@ -75,6 +77,11 @@ class PhotometricModel {
 /// (0.9996: 2^16 equally probable cells at their centre quantiles).
 double image_noise_normal_variance();
 
+/// The auto-exposure loop of sensors.camera.auto_exposure: next exposure from
+/// the current one and the mean of the image it gave (see AutoExposureOptions).
+double next_auto_exposure_ms(const AutoExposureOptions& options, double exposure_ms,
+                             double image_mean_dn);
+
 /// One camera's photometric effects with its own stream (NAME.noise, e.g.
 /// "camera.left.noise"), so that left and right noise are independent and
 /// neither depends on the other sensors.
@@ -82,6 +89,7 @@ class CameraImageNoise {
  public:
   CameraImageNoise(const CameraOptions& camera, const RngStreams& rng, const std::string& name);
   void apply(cv::Mat* image) { model_.apply(image, &rng_); }
+  void apply(cv::Mat* image, double exposure_ms) { model_.apply(image, &rng_, exposure_ms); }
   const PhotometricModel& model() const { return model_; }
 
  private:

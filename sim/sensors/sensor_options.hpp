@@ -104,6 +104,33 @@ struct StereoCalibrationErrorOptions {
   }
 };
 
+/// Auto exposure: after each frame the exposure moves towards the one that
+/// would give the left image a mean of target_mean_dn, by a fraction
+/// `response` of the step in log exposure (a first-order loop, as camera
+/// firmware does over a few frames), within [min_exposure_ms, max_exposure_ms].
+/// Both cameras of the pair share the exposure.
+struct AutoExposureOptions {
+  bool enabled = false;
+  double target_mean_dn = 110.0;
+  double response = 0.5;
+  double min_exposure_ms = 0.05;
+  double max_exposure_ms = 20.0;
+
+  template <class A>
+  void visit(A& a) {
+    a("enabled", enabled, "Adjust exposure_ms frame by frame towards target_mean_dn");
+    a("target_mean_dn", target_mean_dn, "Mean left-image value the loop aims at [DN]",
+      yaml::in_range(1, 254));
+    a("response", response,
+      "Fraction of the log-exposure step taken per frame (1 = jump to the estimate)",
+      yaml::in_range(0.01, 1));
+    a("min_exposure_ms", min_exposure_ms, "Shortest exposure [ms]", yaml::positive());
+    a("max_exposure_ms", max_exposure_ms, "Longest exposure [ms]", yaml::positive());
+    a.require(min_exposure_ms <= max_exposure_ms, "max_exposure_ms",
+              "max_exposure_ms >= min_exposure_ms");
+  }
+};
+
 /// Lens distortion of both cameras (Brown-Conrady, OpenCV's order k1, k2, p1,
 /// p2, k3 on normalised coordinates) and the rectification that removes it
 /// again with the calibrated coefficients (true + calibration_error), so that
@@ -141,6 +168,7 @@ struct CameraOptions {
   MountOptions mount;
   CameraNoiseOptions noise;
   double vignetting_strength = 0.0;
+  AutoExposureOptions auto_exposure;
   StereoCalibrationErrorOptions calibration_error;
   LensDistortionOptions lens_distortion;
   ClockOptions clock;
@@ -168,6 +196,9 @@ struct CameraOptions {
     a("vignetting_strength", vignetting_strength,
       "Blend of cos^4 vignetting: 0 = none, 1 = the full cos^4 law of the pinhole's field angle",
       yaml::unit_interval());
+    a("auto_exposure", auto_exposure, "Exposure control loop (exposure_ms is its start)");
+    a.require(!auto_exposure.enabled || auto_exposure.max_exposure_ms * 1e-3 * rate_hz <= 1.0,
+              "auto_exposure", "a max_exposure_ms no longer than the frame period");
     a("calibration_error", calibration_error, "Stereo miscalibration (true rig vs nominal)");
     a("lens_distortion", lens_distortion, "Lens distortion and rectification of both images");
     a.require(baseline_m + calibration_error.baseline_error_m > 0, "calibration_error",

@@ -141,6 +141,35 @@ TEST(CameraStage, TheRightCameraIsRenderedWhereTheMiscalibratedRigPutsIt) {
   EXPECT_EQ(got.right.pixels, direct.left.pixels);
 }
 
+// Auto exposure: starting 8x too long (a saturated frame), the loop brings the
+// left image's mean to the target; the image mean scales with the exposure,
+// so the settled exposure is the one that scales the reference render's mean
+// to the target (computed here from the render at the reference exposure).
+TEST(CameraStage, AutoExposureSettlesOnTheTargetMean) {
+  Scenario sc = river();
+  Rendering r(sc);
+  auto mean_of = [](const sim::GrayImage& g) {
+    double m = 0;
+    for (std::uint8_t v : g.pixels) m += v;
+    return m / static_cast<double>(g.pixels.size());
+  };
+  const double reference_mean = mean_of(CameraStage(sc, &r.renderer, RngStreams(1)).capture(frame()).left);
+  sc.sensors.camera.auto_exposure.enabled = true;
+  sc.sensors.camera.auto_exposure.target_mean_dn = 80;
+  sc.sensors.camera.exposure_ms = 40;  // 8x the reference exposure of 5 ms
+  CameraStage stage(sc, &r.renderer, RngStreams(1));
+  EXPECT_EQ(stage.exposure_ms(), 20.0);  // clamped to max_exposure_ms
+  double mean = 0;
+  for (int k = 0; k < 15; ++k) mean = mean_of(stage.capture(frame()).left);
+  EXPECT_NEAR(mean, 80.0, 1.5);
+  // Linear camera: exposure = reference exposure * target / reference mean
+  // (a little off where pixels clip).
+  EXPECT_NEAR(stage.exposure_ms(), 5.0 * 80.0 / reference_mean, 0.05 * 5.0 * 80.0 / reference_mean);
+  // Bad options name the field.
+  sc.sensors.camera.auto_exposure.max_exposure_ms = 100;  // longer than 1 / 13 Hz
+  EXPECT_THROW(validate_scenario(sc, "test"), UserError);
+}
+
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);
   std::stringstream ss;
