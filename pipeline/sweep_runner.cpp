@@ -226,7 +226,7 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
     lock.acquire(m.dir / ".sweep-run.lock");
     leftover_temporaries(m, /*remove=*/true);
   }
-  std::vector<const SweepJob*> todo;
+  std::vector<const SweepJob*> pending;
   for (const auto& job : m.jobs) {
     if (options.shard && !in_shard(job, *options.shard)) continue;
     ++summary.jobs;
@@ -234,7 +234,7 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
       ++summary.skipped;
       continue;
     }
-    todo.push_back(&job);
+    pending.push_back(&job);
   }
   fs::create_directories(m.dir / "logs");
 
@@ -245,7 +245,7 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
   };
   std::vector<Running> running;
   SweepProgress progress;
-  progress.total = todo.size();
+  progress.total = pending.size();
   progress.skipped = summary.skipped;
   auto report = [&] {
     progress.running = running.size();
@@ -263,8 +263,8 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
   std::size_t next = 0;
   bool first_report = true;
   try {
-    while (next < todo.size() || !running.empty()) {
-      while (running.size() < options.parallel && next < todo.size()) start(todo[next++]);
+    while (next < pending.size() || !running.empty()) {
+      while (running.size() < options.parallel && next < pending.size()) start(pending[next++]);
       if (first_report) {
         report();
         first_report = false;
@@ -298,12 +298,12 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
           write_failure(m, *r.job, why, tail_of(log));
         }
         // The next job starts before the report, so that "running" counts it.
-        while (running.size() < options.parallel && next < todo.size()) start(todo[next++]);
+        while (running.size() < options.parallel && next < pending.size()) start(pending[next++]);
         report();
       }
       if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    if (todo.empty()) report();
+    if (pending.empty()) report();
   } catch (...) {
     for (const auto& r : running) ::kill(r.pid, SIGTERM);
     for (const auto& r : running) wait_process(r.pid);
