@@ -86,26 +86,19 @@ std::optional<CompassSample> CompassSimulator::measure(const BodySample& b) {
   return s;
 }
 
-CompassCsvWriter::CompassCsvWriter(const std::filesystem::path& path) : file_(path) {
-  file_.write("#timestamp [ns],heading [deg],m_S_x [nT],m_S_y [nT],m_S_z [nT]\n");
-}
+CompassCsvWriter::CompassCsvWriter(const std::filesystem::path& path)
+    : rows_(path, "#timestamp [ns],heading [deg],m_S_x [nT],m_S_y [nT],m_S_z [nT]\n", "compass") {}
 
 void CompassCsvWriter::write(const CompassSample& s) {
   DRIFTLAB_DEMAND_MSG(std::isfinite(s.heading_rad) && s.field_S_nt.allFinite(),
                       fmt::format("compass sample at t = {} ns is not finite", s.t_ns));
-  DRIFTLAB_DEMAND_MSG(!any_ || s.t_ns > last_ns_,
-                      fmt::format("compass time stamps do not increase at t = {} ns", s.t_ns));
-  any_ = true;
-  last_ns_ = s.t_ns;
-  line_.clear();
-  csv_detail::append_int(&line_, s.t_ns);
+  std::string* line = rows_.begin_row(s.t_ns);
   double deg = rad2deg(s.heading_rad);
   if (deg < 0) deg += 360.0;
   if (deg >= 360.0) deg -= 360.0;  // -tiny + 360 can round to 360
-  csv_detail::append_double(&line_, deg);
-  for (int i = 0; i < 3; ++i) csv_detail::append_double(&line_, s.field_S_nt[i]);
-  line_ += '\n';
-  file_.write(line_);
+  csv_detail::append_double(line, deg);
+  for (int i = 0; i < 3; ++i) csv_detail::append_double(line, s.field_S_nt[i]);
+  rows_.end_row();
 }
 
 }  // namespace driftlab::sim

@@ -16,6 +16,7 @@
 #include "core/rng.hpp"
 #include "core/time.hpp"
 #include "sim/sensors/clock.hpp"
+#include "sim/sensors/csv_detail.hpp"
 #include "sim/sensors/sensor_options.hpp"
 #include "sim/vessel/simulator.hpp"
 
@@ -77,13 +78,10 @@ class CompassCsvWriter {
   explicit CompassCsvWriter(const std::filesystem::path& path);
   /// Appends one sample; stamps must strictly increase and values be finite (InternalError).
   void write(const CompassSample& s);
-  void commit() { file_.commit(); }
+  void commit() { rows_.commit(); }
 
  private:
-  AtomicFile file_;
-  std::string line_;
-  TimeNs last_ns_ = 0;
-  bool any_ = false;
+  csv_detail::StampedRows rows_;
 };
 
 }  // namespace driftlab::sim

@@ -188,29 +188,23 @@ std::optional<GpsFix> GpsSimulator::measure(const BodySample& b) {
   return f;
 }
 
-GpsCsvWriter::GpsCsvWriter(const std::filesystem::path& path) : file_(path) {
-  file_.write(
-      "#timestamp [ns],fix [0/1],satellites [],hdop [],north [m],east [m],down [m],"
-      "latitude [deg],longitude [deg],height [m]\n");
-}
+GpsCsvWriter::GpsCsvWriter(const std::filesystem::path& path)
+    : rows_(path,
+            "#timestamp [ns],fix [0/1],satellites [],hdop [],north [m],east [m],down [m],"
+            "latitude [deg],longitude [deg],height [m]\n",
+            "GPS") {}
 
 void GpsCsvWriter::write(const GpsFix& f) {
-  DRIFTLAB_DEMAND_MSG(!any_ || f.t_ns > last_ns_,
-                      fmt::format("GPS time stamps do not increase at t = {} ns", f.t_ns));
-  any_ = true;
-  last_ns_ = f.t_ns;
-  line_.clear();
-  csv_detail::append_int(&line_, f.t_ns);
-  line_ += f.fix ? ",1," : ",0,";
-  csv_detail::append_int(&line_, f.satellites);
-  csv_detail::append_double(&line_, f.hdop);
+  std::string* line = rows_.begin_row(f.t_ns);
+  *line += f.fix ? ",1," : ",0,";
+  csv_detail::append_int(line, f.satellites);
+  csv_detail::append_double(line, f.hdop);
   const bool fix = f.fix;
-  for (int i = 0; i < 3; ++i) csv_detail::append_double(&line_, fix ? f.p_W[i] : kGpsNaN);
-  csv_detail::append_double(&line_, fix ? f.geodetic.lat_deg : kGpsNaN);
-  csv_detail::append_double(&line_, fix ? f.geodetic.lon_deg : kGpsNaN);
-  csv_detail::append_double(&line_, fix ? f.geodetic.height_m : kGpsNaN);
-  line_ += '\n';
-  file_.write(line_);
+  for (int i = 0; i < 3; ++i) csv_detail::append_double(line, fix ? f.p_W[i] : kGpsNaN);
+  csv_detail::append_double(line, fix ? f.geodetic.lat_deg : kGpsNaN);
+  csv_detail::append_double(line, fix ? f.geodetic.lon_deg : kGpsNaN);
+  csv_detail::append_double(line, fix ? f.geodetic.height_m : kGpsNaN);
+  rows_.end_row();
 }
 
 }  // namespace driftlab::sim

@@ -19,6 +19,7 @@
 #include "core/rng.hpp"
 #include "core/time.hpp"
 #include "sim/sensors/clock.hpp"
+#include "sim/sensors/csv_detail.hpp"
 #include "sim/sensors/geodesy.hpp"
 #include "sim/sensors/sensor_options.hpp"
 #include "sim/sensors/sky.hpp"
@@ -144,13 +145,10 @@ class GpsCsvWriter {
   explicit GpsCsvWriter(const std::filesystem::path& path);
   /// Appends one epoch; stamps must strictly increase (InternalError).
   void write(const GpsFix& fix);
-  void commit() { file_.commit(); }
+  void commit() { rows_.commit(); }
 
  private:
-  AtomicFile file_;
-  std::string line_;
-  TimeNs last_ns_ = 0;
-  bool any_ = false;
+  csv_detail::StampedRows rows_;
 };
 
 }  // namespace driftlab::sim

@@ -82,25 +82,19 @@ std::optional<ImuSample> ImuSimulator::measure(const BodySample& b) {
   return out;
 }
 
-ImuCsvWriter::ImuCsvWriter(const std::filesystem::path& path) : file_(path) {
-  file_.write(
-      "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
-      "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n");
-}
+ImuCsvWriter::ImuCsvWriter(const std::filesystem::path& path)
+    : rows_(path,
+            "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
+            "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n",
+            "IMU") {}
 
 void ImuCsvWriter::write(const ImuSample& s) {
   DRIFTLAB_DEMAND_MSG(s.gyro_rad_s.allFinite() && s.accel_m_s2.allFinite(),
                       fmt::format("IMU sample at t = {} ns is not finite", s.t_ns));
-  DRIFTLAB_DEMAND_MSG(!any_ || s.t_ns > last_ns_,
-                      fmt::format("IMU time stamps do not increase at t = {} ns", s.t_ns));
-  any_ = true;
-  last_ns_ = s.t_ns;
-  line_.clear();
-  csv_detail::append_int(&line_, s.t_ns);
+  std::string* line = rows_.begin_row(s.t_ns);
   for (const Vec3* v : {&s.gyro_rad_s, &s.accel_m_s2})
-    for (int i = 0; i < 3; ++i) csv_detail::append_double(&line_, (*v)[i]);
-  line_ += '\n';
-  file_.write(line_);
+    for (int i = 0; i < 3; ++i) csv_detail::append_double(line, (*v)[i]);
+  rows_.end_row();
 }
 
 }  // namespace driftlab::sim

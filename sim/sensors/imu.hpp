@@ -26,6 +26,7 @@
 #include "core/rng.hpp"
 #include "core/trajectory_io.hpp"
 #include "sim/sensors/clock.hpp"
+#include "sim/sensors/csv_detail.hpp"
 #include "sim/sensors/sensor_options.hpp"
 #include "sim/vessel/simulator.hpp"
 
@@ -87,13 +88,10 @@ class ImuCsvWriter {
   explicit ImuCsvWriter(const std::filesystem::path& path);
   /// Appends one row; stamps must strictly increase and values be finite (InternalError).
   void write(const ImuSample& s);
-  void commit() { file_.commit(); }
+  void commit() { rows_.commit(); }
 
  private:
-  AtomicFile file_;
-  std::string line_;
-  TimeNs last_ns_ = 0;
-  bool any_ = false;
+  csv_detail::StampedRows rows_;
 };
 
 }  // namespace driftlab::sim
