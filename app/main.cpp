@@ -1,6 +1,5 @@
-// The `driftlab` command line. Library code throws; this file alone maps
-// exceptions to exit codes: 0 success, 1 bad input (UserError), 2 bad command
-// line, 3 a stage this build does not have yet, 4 internal error.
+// The `driftlab` command line: declares the verbs and wires in the study and
+// gate commands; app/cli_main.cpp maps exceptions to the documented exit codes.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
@@ -13,7 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "app/sweep_commands.hpp"
+#include "app/cli_main.hpp"
+#include "app/gate_command.hpp"
+#include "app/study_commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/trajectory_io.hpp"
@@ -30,15 +31,6 @@ namespace {
 
 using driftlab::UserError;
 namespace fs = std::filesystem;
-
-constexpr int kExitUserError = 1;
-constexpr int kExitUnavailable = 3;
-constexpr int kExitInternal = 4;
-
-/// A subcommand whose stage lands with a later issue.
-struct Unavailable : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 int scenario_check(const std::string& file, const std::vector<std::string>& overrides,
                    bool quiet) {
@@ -216,20 +208,18 @@ int main(int argc, char** argv) {
   eval_cmd->add_option("--out", ev.out, "Output folder (written atomically)")->required();
   eval_cmd->add_flag("--force", ev.force, "Replace an existing output folder");
 
-  // sweep plan|run|status|merge|slurm-script, regress, and run --manifest/--job/--shard.
-  driftlab::app::SweepCommands sweep_commands(app);
-  sweep_commands.add_run_options(run_cmd, run_scenario_opt, run_out_opt, &run_force);
+  // sweep plan|run|status|merge|slurm-script, and run --manifest/--job/--shard.
+  driftlab::app::StudyCommands study_commands(app);
+  study_commands.add_run_options(run_cmd, run_scenario_opt, run_out_opt, &run_force);
+  // regress: the CI baseline gate (also built alone as driftlab-gate).
+  driftlab::app::GateCommand gate_command(app.add_subcommand(
+      "regress", "Compare metrics with a baseline (CI regression gate); exit 1 on a regression"));
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
-
-  try {
+  return driftlab::app::run_cli_main(app, argc, argv, [&]() -> int {
     if (check_cmd->parsed()) return scenario_check(check_file, check_sets, check_quiet);
     if (schema_cmd->parsed()) return scenario_schema(schema_out);
-    if (const auto rc = sweep_commands.dispatch()) return *rc;
+    if (const auto rc = study_commands.dispatch()) return *rc;
+    if (const auto rc = gate_command.dispatch()) return *rc;
     if (run_cmd->parsed()) return run_command(run_file, run_out, run_sets, run_seed, run_force, run_only_motion);
     if (render_cmd->parsed()) {
       const auto scenario = driftlab::pipeline::load_scenario(render_file, render_sets);
@@ -242,15 +232,6 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (eval_cmd->parsed()) return eval_command(ev);
-  } catch (const Unavailable& e) {
-    std::cerr << "driftlab: not available in this build yet: " << e.what() << "\n";
-    return kExitUnavailable;
-  } catch (const UserError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return kExitUserError;
-  } catch (const std::exception& e) {
-    std::cerr << "driftlab: internal error: " << e.what() << "\n";
-    return kExitInternal;
-  }
-  return 0;
+    return 0;
+  });
 }

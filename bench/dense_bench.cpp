@@ -34,6 +34,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/rgbd.hpp>
 
+#include "core/stopwatch.hpp"
 #include "core/rng.hpp"
 #include "tests/vo/vo_test_sequences.hpp"
 #include "vo/dense/dense_vo.hpp"
@@ -44,14 +45,8 @@ namespace {
 
 using namespace driftlab;
 using namespace driftlab::vo;
-using Clock = std::chrono::steady_clock;
-
 constexpr std::size_t kFrames = 8;
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 const test::Sequence& sequence() {
   static const test::Sequence s =
@@ -277,11 +272,11 @@ void BM_RgbdOdometry(benchmark::State& state) {
   for (auto _ : state) {
     const std::size_t from = ping_pong(i - 1), to = ping_pong(i);
     ++i;
-    auto t = Clock::now();
+    auto t = SteadyClock::now();
     cv::Ptr<cv::rgbd::OdometryFrame> cur = frame(to);
     odo->prepareFrameCache(cur, cv::rgbd::OdometryFrame::CACHE_ALL);
     cache_ms += ms_since(t);
-    t = Clock::now();
+    t = SteadyClock::now();
     cv::Mat Rt;
     const bool ok = odo->compute(prev, cur, Rt);
     compute_ms += ms_since(t);

@@ -47,7 +47,7 @@ function(driftlab_test source)
   set(target test_${prefix}_${stem})
   add_executable(${target} ${source})
   driftlab_warnings(${target})
-  target_link_libraries(${target} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
+  target_link_libraries(${target} PRIVATE ${T_LIBS} driftlab_test_support GTest::gtest GTest::gtest_main)
   target_compile_definitions(${target} PRIVATE
     DRIFTLAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     DRIFTLAB_BINARY_DIR="${PROJECT_BINARY_DIR}")

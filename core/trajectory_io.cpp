@@ -14,6 +14,7 @@
 #include <system_error>
 
 #include "core/atomic_file.hpp"
+#include "core/csv.hpp"
 #include "core/error.hpp"
 
 namespace driftlab {
@@ -109,20 +110,6 @@ void split_whitespace(std::string_view line, std::vector<std::string_view>* toke
     if (last == std::string_view::npos) last = line.size();
     tokens->push_back(line.substr(first, last - first));
     pos = last;
-  }
-}
-
-void split_csv(std::string_view line, std::vector<std::string_view>* tokens) {
-  tokens->clear();
-  std::size_t pos = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', pos);
-    if (comma == std::string_view::npos) {
-      tokens->push_back(trim(line.substr(pos)));
-      return;
-    }
-    tokens->push_back(trim(line.substr(pos, comma - pos)));
-    pos = comma + 1;
   }
 }
 
@@ -499,7 +486,8 @@ Trajectory read_euroc_groundtruth(const fs::path& path) {
   std::vector<std::string_view> tokens;
   StrictOrder order;
   while (c.next()) {
-    split_csv(c.line(), &tokens);
+    const std::vector<std::string> cells = split_csv_line(c.line(), CsvTrim::kSpaces);
+    tokens.assign(cells.begin(), cells.end());
     check_column_count(c, tokens, kEurocGtColumns);
     const TimeNs t_ns = column_nanoseconds(c, tokens, 0, kEurocGtColumns);
     const Vec3 p = column_vec3(c, tokens, 1, kEurocGtColumns);
@@ -545,7 +533,8 @@ std::vector<ImuSample> read_euroc_imu(const fs::path& path) {
   std::vector<std::string_view> tokens;
   StrictOrder order;
   while (c.next()) {
-    split_csv(c.line(), &tokens);
+    const std::vector<std::string> cells = split_csv_line(c.line(), CsvTrim::kSpaces);
+    tokens.assign(cells.begin(), cells.end());
     check_column_count(c, tokens, kEurocImuColumns);
     ImuSample s;
     s.t_ns = column_nanoseconds(c, tokens, 0, kEurocImuColumns);

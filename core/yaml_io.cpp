@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/file_io.hpp"
+
 namespace driftlab::yaml {
 
 // ---------------------------------------------------------------------------
@@ -277,16 +279,7 @@ void Reader::finish() {
 // Loading
 
 YAML::Node load_file(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    throw UserError(fmt::format("{}: no such file", path));
-  if (std::filesystem::is_directory(path, ec))
-    throw UserError(fmt::format("{}: is a directory, expected a YAML file", path));
-  std::ifstream in(path);
-  if (!in) throw UserError(fmt::format("{}: cannot open for reading", path));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return load_string(ss.str(), path);
+  return load_string(read_text_file(path, "YAML file"), path);
 }
 
 YAML::Node load_string(const std::string& text, const std::string& label) {

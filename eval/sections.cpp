@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/yaml_io.hpp"
 
@@ -14,19 +15,6 @@ namespace driftlab::eval {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::vector<std::string> split_csv(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  std::stringstream ss(line);
-  while (std::getline(ss, cell, ',')) {
-    const auto b = cell.find_first_not_of(" \t");
-    const auto e = cell.find_last_not_of(" \t\r");
-    cells.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
-  }
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
-  return cells;
-}
 
 // Yaw angles unwrapped into a continuous sequence, so that a turn through
 // +-180 deg does not inflate the standard deviation.
@@ -73,7 +61,7 @@ FrameTable read_frame_table(const std::string& path) {
   while (std::getline(in, line)) {
     ++line_no;
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
-    header = split_csv(line);
+    header = split_csv_line(line, CsvTrim::kSpaces);
     break;
   }
   if (header.empty()) throw UserError(fmt::format("{}: no header line, expected CSV with a header", path));
@@ -102,7 +90,7 @@ FrameTable read_frame_table(const std::string& path) {
   while (std::getline(in, line)) {
     ++line_no;
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
-    const auto cells = split_csv(line);
+    const auto cells = split_csv_line(line, CsvTrim::kSpaces);
     if (cells.size() != header.size())
       throw UserError(fmt::format("{}:{}: got {} columns, expected {} as in the header", path,
                                   line_no, cells.size(), header.size()));

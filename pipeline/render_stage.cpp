@@ -9,6 +9,7 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/rng.hpp"
+#include "core/stopwatch.hpp"
 #include "core/trajectory_io.hpp"
 #include "pipeline/camera_stage.hpp"
 #include "pipeline/run.hpp"
@@ -19,7 +20,6 @@
 namespace driftlab::pipeline {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 
 void write_png(const std::filesystem::path& path, const sim::GrayImage& img) {
   const cv::Mat m(img.height, img.width, CV_8UC1, const_cast<std::uint8_t*>(img.pixels.data()));
@@ -81,9 +81,9 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
   }
 
   RenderSequenceSummary summary;
-  const auto t_scene = Clock::now();
+  const auto t_scene = SteadyClock::now();
   const sim::SceneGeometry scene = scenes::build_scene(sc.scene, sc.seed, north_min, north_max);
-  summary.scene_build_s = std::chrono::duration<double>(Clock::now() - t_scene).count();
+  summary.scene_build_s = seconds_since(t_scene);
   sim::StereoRenderer renderer(rig_of(sc.sensors.camera), sc.render);
   renderer.upload(scene);
   renderer.set_waves(
@@ -104,11 +104,11 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
   std::size_t delivered = 0;
   for (std::size_t k = 0; k < poses.size(); ++k) {
     if (k < stamps.size() && stamps[k].dropped) continue;
-    const auto t0 = Clock::now();
+    const auto t0 = SteadyClock::now();
     sim::StereoImages img = camera.capture(truth[k]);
     if (depth)  // ground truth: the ideal pinhole depth at the centre of the exposure
       img.depth_left = renderer.render(poses[k].T_W_C, ns_to_seconds(poses[k].t_ns), true).depth_left;
-    render_s += std::chrono::duration<double>(Clock::now() - t0).count();
+    render_s += seconds_since(t0);
     ++delivered;
     const std::string name = fmt::format("{:06d}", k);
     write_png(dir.path() / "left" / (name + ".png"), img.left);

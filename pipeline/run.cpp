@@ -11,6 +11,7 @@
 #include "core/atomic_file.hpp"
 #include "core/rotation.hpp"
 #include "core/rng.hpp"
+#include "core/stopwatch.hpp"
 #include "core/trajectory_io.hpp"
 #include "core/yaml_io.hpp"
 #include "eval/evaluate.hpp"
@@ -19,7 +20,7 @@
 #include "pipeline/filter_stage.hpp"
 #include "pipeline/progress.hpp"
 #include "pipeline/render_stage.hpp"
-#include "pipeline/report.hpp"
+#include "report/run_report.hpp"
 #include "pipeline/sensor_stage.hpp"
 #include "scenes/build_scene.hpp"
 #include "sim/render/renderer.hpp"
@@ -38,12 +39,6 @@
 
 namespace driftlab::pipeline {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 std::string body_csv_header() {
   return "t_ns,north_m,east_m,down_m,qw,qx,qy,qz,roll_deg,pitch_deg,yaw_deg,"
@@ -277,11 +272,11 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
       continue;
     }
     const TimeNs t = stamps[k].t_stamp_ns;  // what the camera's clock wrote
-    const auto t_render = std::chrono::steady_clock::now();
+    const Stopwatch t_render;
     const double exposure_ms = camera.exposure_ms();  // this frame's (auto exposure)
     const sim::StereoImages img = camera.capture(frame_truth[k]);
     const double render_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_render).count();
+        t_render.ms();
     render_s += render_ms / 1000;
     vo::StereoFrame frame;
     frame.t_ns = t;
@@ -374,11 +369,11 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   write_file_atomic(dir / "sections.csv", sections);
 
   // Report: plots (gnuplot) and the same report as HTML.
-  std::vector<NamedTrajectory> named;
+  std::vector<report::NamedTrajectory> named;
   for (const auto& tr : tracks) named.push_back({tr.name, tr.estimate});
-  std::string plot_warning;
-  std::vector<PlotFile> plots = make_plots(dir, camera_gt, named, sections, &plot_warning);
-  if (!plot_warning.empty()) warnings.push_back(plot_warning);
+  report::PlotSet made = report::make_plots(dir, camera_gt, named, sections);
+  if (!made.warning.empty()) warnings.push_back(made.warning);
+  std::vector<report::PlotFile>& plots = made.files;
   for (const auto& tr : tracks)
     if (std::filesystem::exists(dir / "plots" / (tr.name + "_matches.png")))
       plots.push_back({fmt::format("Stereo pair at frame {} with the {} matches: current left "
@@ -390,7 +385,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   if (!plots.empty()) report += "## Plots\n\n";
   for (const auto& p : plots) report += fmt::format("![{}]({})\n\n", p.title, p.file);
   write_file_atomic(dir / "report.md", report);
-  write_file_atomic(dir / "report.html", report_html("driftlab run: " + sc.name, tables, plots));
+  write_file_atomic(dir / "report.html", report::report_html("driftlab run: " + sc.name, tables, plots));
   (*metrics)["timing"]["render_s"] = render_s;
   (*metrics)["timing"]["render_pairs_per_s"] =
       render_s > 0 ? static_cast<double>(camera_gt.size() - dropped) / render_s : 0.0;
@@ -410,7 +405,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
 
 RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir,
                         const RunOptions& options) {
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   validate_scenario(sc, "scenario '" + sc.name + "'");
   RunSummary summary;
   AtomicDirectory dir(out_dir, options.replace_existing);
@@ -423,7 +418,7 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
   std::vector<EulerZYX> platform;  // body attitude at each frame (the IMU's, for covariate h)
   AtomicFile body(dir.path() / "body_groundtruth.csv");
   body.write(body_csv_header());
-  const auto t_physics = Clock::now();
+  const auto t_physics = SteadyClock::now();
   SensorStage sensors(sc, dir.path());
   summary.motion = simulate_scenario_motion(
       sc, [&](const sim::BodySample& b) { body.write(body_csv_row(b)); },
@@ -446,7 +441,7 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
 
   nlohmann::json metrics;
   // Stage: sensors. GPS and compass need the scene (sky obstruction, steel structures).
-  const auto t_sensors = Clock::now();
+  const auto t_sensors = SteadyClock::now();
   std::optional<sim::SceneGeometry> scene;
   if (!camera_gt.empty()) scene = scene_for_track(sc, camera_gt);
   const SensorData sensor_data = sensors.finish(scene ? &*scene : nullptr);

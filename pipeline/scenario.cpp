@@ -6,7 +6,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/csv.hpp"
 #include "core/error.hpp"
+#include "core/file_io.hpp"
 
 namespace driftlab::pipeline {
 namespace {
@@ -48,14 +50,7 @@ std::vector<std::array<double, 2>> read_waypoints_csv(const std::filesystem::pat
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const auto first = line.find_first_not_of(" \t");
     if (first == std::string::npos || line[first] == '#') continue;
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) {
-      const auto b = cell.find_first_not_of(" \t");
-      const auto e = cell.find_last_not_of(" \t");
-      cells.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
-    }
+    const std::vector<std::string> cells = split_csv_line(line, CsvTrim::kSpaces);
     double n = 0, e = 0;
     const bool numbers = cells.size() == 2 && yaml::parse_double(cells[0], &n) &&
                          yaml::parse_double(cells[1], &e);
@@ -140,17 +135,8 @@ Scenario parse_scenario(const std::string& text, const std::string& label,
 
 Scenario load_scenario(const std::filesystem::path& path,
                        const std::vector<std::string>& overrides) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    throw UserError(fmt::format("{}: no such scenario file", path.string()));
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw UserError(fmt::format("{}: not a regular file, expected a scenario YAML file",
-                                path.string()));
-  std::ifstream in(path);
-  if (!in) throw UserError(fmt::format("{}: cannot open for reading", path.string()));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_scenario(ss.str(), path.string(), path.parent_path(), overrides);
+  return parse_scenario(read_text_file(path, "scenario file"), path.string(), path.parent_path(),
+                        overrides);
 }
 
 std::string resolved_yaml(const Scenario& scenario) {

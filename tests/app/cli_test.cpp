@@ -10,56 +10,20 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "tests/support/test_support.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
+using Result = driftlab::test::CommandResult;
+using driftlab::test::fresh_temp_dir;
+using driftlab::test::run_cli;
+using driftlab::test::shell_quote;
+using driftlab::test::slurp;
+
 const fs::path kSource = DRIFTLAB_SOURCE_DIR;
 const fs::path kCli = fs::path(DRIFTLAB_BINARY_DIR) / "bin" / "driftlab";
-
-struct Result {
-  int exit_code;
-  std::string out;     // standard output
-  std::string err;     // standard error
-  std::string output;  // both, for searching messages
-};
-
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-Result run_cli(const std::vector<std::string>& args, const std::string& env = "") {
-  const std::string stem = "driftlab_cli_" + std::to_string(::getpid());
-  const fs::path out_log = fs::temp_directory_path() / (stem + ".out");
-  const fs::path err_log = fs::temp_directory_path() / (stem + ".err");
-  std::string cmd = env + (env.empty() ? "" : " ") + quote(kCli.string());
-  for (const auto& a : args) cmd += " " + quote(a);
-  cmd += " > " + quote(out_log.string()) + " 2> " + quote(err_log.string());
-  const int status = std::system(cmd.c_str());
-  Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out_log), slurp(err_log), ""};
-  r.output = r.out + r.err;
-  fs::remove(out_log);
-  fs::remove(err_log);
-  return r;
-}
-
-fs::path fresh_temp_dir(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("driftlab_test_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 std::string read_text(const fs::path& p) { return slurp(p); }
 
@@ -189,14 +153,14 @@ TEST(Cli, KilledRunLeavesNoOutputFolder) {
   const fs::path dir = fresh_temp_dir("killed");
   const fs::path out = dir / "out";
   const fs::path log = dir / "log";
-  const std::string cmd = quote(kCli.string()) + " run " +
-                          quote((kSource / "scenarios/river_crossing.yaml").string()) +
-                          " --out " + quote(out.string()) + " > " + quote(log.string()) +
+  const std::string cmd = shell_quote(kCli.string()) + " run " +
+                          shell_quote((kSource / "scenarios/river_crossing.yaml").string()) +
+                          " --out " + shell_quote(out.string()) + " > " + shell_quote(log.string()) +
                           " 2>&1 & pid=$!; " +
                           // wait until the frame loop reports progress, then kill
-                          "for i in $(seq 1 600); do grep -q frames " + quote(log.string()) +
+                          "for i in $(seq 1 600); do grep -q frames " + shell_quote(log.string()) +
                           " && break; sleep 0.1; done; kill -9 $pid; wait $pid";
-  const int status = std::system(("bash -c " + quote(cmd)).c_str());
+  const int status = std::system(("bash -c " + shell_quote(cmd)).c_str());
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 128 + 9) << read_text(log);  // it was still running
   EXPECT_NE(read_text(log).find("frames"), std::string::npos);

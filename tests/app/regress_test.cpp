@@ -10,44 +10,18 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "tests/support/test_support.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
+using Result = driftlab::test::CommandResult;
+using driftlab::test::run_cli;
+using driftlab::test::shell_quote;
+using driftlab::test::slurp;
+
 const fs::path kCli = fs::path(DRIFTLAB_BINARY_DIR) / "bin" / "driftlab";
-
-struct Result {
-  int exit_code;
-  std::string out, err;
-};
-
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-Result run_cli(const std::vector<std::string>& args) {
-  const std::string base =
-      (fs::temp_directory_path() / ("driftlab_regress_cli_" + std::to_string(::getpid()))).string();
-  std::string cmd = quote(kCli.string());
-  for (const auto& a : args) cmd += " " + quote(a);
-  cmd += " > " + quote(base + ".out") + " 2> " + quote(base + ".err");
-  const int status = std::system(cmd.c_str());
-  Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(base + ".out"),
-           slurp(base + ".err")};
-  fs::remove(base + ".out");
-  fs::remove(base + ".err");
-  return r;
-}
 
 class Regress : public ::testing::Test {
  protected:
@@ -228,6 +202,36 @@ TEST_F(Regress, ReadsAMergedSweepAndExplainsAnUnmergedOne) {
   r = run_cli({"regress", "--baseline", baseline().string(), "--results", sweep.string()});
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("1 metrics: 1 pass"), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+namespace {
+
+// driftlab-gate is the same command as `driftlab regress`, built from the gate module alone: it
+// gives the same verdicts and table, and links none of the renderer's, Ceres' or assimp's
+// libraries (nor OpenCV's), so a CI machine that only gates need not build them.
+TEST_F(Regress, StandaloneGateBinaryMatchesRegressAndLinksNoRendererCeresOrAssimp) {
+  const fs::path gate_bin = fs::path(DRIFTLAB_BINARY_DIR) / "bin" / "driftlab-gate";
+  ASSERT_TRUE(fs::exists(gate_bin)) << gate_bin;
+  write_baseline();
+  write_results(0.0112, 0.44, 7.6);
+  const Result via_driftlab = gate();
+  const Result alone = driftlab::test::run_shell(
+      shell_quote(gate_bin.string()) + " --baseline " + shell_quote(baseline().string()) +
+      " --results " + shell_quote((dir_ / "run").string()));
+  EXPECT_EQ(alone.exit_code, 1) << alone.output;
+  EXPECT_EQ(alone.exit_code, via_driftlab.exit_code);
+  EXPECT_EQ(alone.out, via_driftlab.out);
+
+  const Result ldd = driftlab::test::run_shell("ldd " + shell_quote(gate_bin.string()));
+  ASSERT_EQ(ldd.exit_code, 0) << ldd.output;
+  EXPECT_NE(ldd.out.find("libyaml-cpp"), std::string::npos) << ldd.out;  // ldd does list libs
+  for (const char* lib : {"OSMesa", "libEGL", "libceres", "libassimp", "libopencv"})
+    EXPECT_EQ(ldd.out.find(lib), std::string::npos) << lib << " in\n" << ldd.out;
+  // The full CLI does link them: the check above can fail.
+  const Result full = driftlab::test::run_shell("ldd " + shell_quote(kCli.string()));
+  EXPECT_NE(full.out.find("OSMesa"), std::string::npos) << full.out;
 }
 
 }  // namespace

@@ -20,22 +20,19 @@
 #include <sstream>
 #include <thread>
 
-#include "pipeline/process.hpp"
+#include "core/process.hpp"
+#include "tests/support/test_support.hpp"
 
-namespace driftlab::pipeline {
+namespace driftlab::study {
 namespace {
+
+using test::shell_quote;
+using test::slurp;
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 const fs::path kSource = DRIFTLAB_SOURCE_DIR;
 const fs::path kCli = fs::path(DRIFTLAB_BINARY_DIR) / "bin" / "driftlab";
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::optional<fs::path> find_program(const std::string& name) {
   if (auto p = find_on_path(name)) return p;
@@ -44,12 +41,6 @@ std::optional<fs::path> find_program(const std::string& name) {
     if (::access(p.c_str(), X_OK) == 0) return p;
   }
   return std::nullopt;
-}
-
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
 }
 
 struct Result {
@@ -61,7 +52,7 @@ struct Result {
 Result sh(const std::string& command) {
   const std::string log =
       (fs::temp_directory_path() / ("driftlab_slurm_sh_" + std::to_string(::getpid()))).string();
-  const int status = std::system((command + " > " + quote(log) + " 2>&1").c_str());
+  const int status = std::system((command + " > " + shell_quote(log) + " 2>&1").c_str());
   Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(log)};
   fs::remove(log);
   return r;
@@ -180,12 +171,12 @@ class SlurmCluster : public ::testing::Test {
   }
 
   Result slurm(const std::string& command_line) {
-    return sh("SLURM_CONF=" + quote(conf_.string()) + " " + command_line);
+    return sh("SLURM_CONF=" + shell_quote(conf_.string()) + " " + command_line);
   }
 
   Result driftlab(const std::vector<std::string>& args) {
-    std::string cmd = quote(kCli.string());
-    for (const auto& a : args) cmd += " " + quote(a);
+    std::string cmd = shell_quote(kCli.string());
+    for (const auto& a : args) cmd += " " + shell_quote(a);
     return sh(cmd);
   }
 
@@ -264,4 +255,4 @@ TEST_F(SlurmCluster, ArrayOfShardsMergesLikeALocalRunAndResubmitsOnlyUnfinishedS
 }
 
 }  // namespace
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::study

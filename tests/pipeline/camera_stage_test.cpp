@@ -19,9 +19,12 @@
 #include "pipeline/render_stage.hpp"
 #include "pipeline/run.hpp"
 #include "scenes/build_scene.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::pipeline {
 namespace {
+
+using test::slurp;
 
 namespace fs = std::filesystem;
 const fs::path kSource = DRIFTLAB_SOURCE_DIR;
@@ -168,13 +171,6 @@ TEST(CameraStage, AutoExposureSettlesOnTheTargetMean) {
   // Bad options name the field.
   sc.sensors.camera.auto_exposure.max_exposure_ms = 100;  // longer than 1 / 13 Hz
   EXPECT_THROW(validate_scenario(sc, "test"), UserError);
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 TEST(CameraStage, RunStampsFramesWithTheCameraClockAndSkipsDroppedOnes) {

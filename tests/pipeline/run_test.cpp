@@ -10,21 +10,17 @@
 
 #include "core/rotation.hpp"
 #include "core/trajectory_io.hpp"
+#include "tests/support/test_support.hpp"
 
 #include <nlohmann/json.hpp>
 
 namespace driftlab::pipeline {
 namespace {
 
+using test::slurp;
+
 namespace fs = std::filesystem;
 const fs::path kSource = DRIFTLAB_SOURCE_DIR;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 fs::path temp_dir(const std::string& name) {
   const fs::path d =

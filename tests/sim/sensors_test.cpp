@@ -24,20 +24,16 @@
 #include "sim/sensors/compass.hpp"
 #include "sim/sensors/gps.hpp"
 #include "sim/sensors/imu.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {
 namespace {
 
+using test::slurp;
+
 namespace fs = std::filesystem;
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kG = 9.80665;
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // Reads `text` as the `sensors` section; returns "" or the UserError message.
 std::string read_error(const std::string& text, SensorOptions* out = nullptr) {
@@ -388,17 +384,17 @@ TEST(SensorFiles, SameSeedSameBytesAndImuCsvReadsBackAsEuroc) {
   write_all(base / "b", 99);
   write_all(base / "c", 100);
   for (const char* f : {"imu.csv", "gps.csv", "compass.csv"}) {
-    EXPECT_EQ(read_text(base / "a" / f), read_text(base / "b" / f)) << f;
-    EXPECT_NE(read_text(base / "a" / f), read_text(base / "c" / f)) << f;
+    EXPECT_EQ(slurp(base / "a" / f), slurp(base / "b" / f)) << f;
+    EXPECT_NE(slurp(base / "a" / f), slurp(base / "c" / f)) << f;
   }
   // imu.csv is an EuRoC IMU file: the strict reader of core accepts it.
   const auto samples = read_euroc_imu(base / "a" / "imu.csv");
   EXPECT_EQ(samples.size(), 1000u);
-  const std::string compass = read_text(base / "a" / "compass.csv");
+  const std::string compass = slurp(base / "a" / "compass.csv");
   EXPECT_EQ(compass.substr(0, compass.find('\n')),
             "#timestamp [ns],heading [deg],m_S_x [nT],m_S_y [nT],m_S_z [nT]");
   EXPECT_EQ(std::count(compass.begin(), compass.end(), '\n'), 51);
-  const std::string gps = read_text(base / "a" / "gps.csv");
+  const std::string gps = slurp(base / "a" / "gps.csv");
   EXPECT_EQ(std::count(gps.begin(), gps.end(), '\n'), 26);
   fs::remove_all(base);
 }
@@ -412,7 +408,7 @@ TEST(SensorFiles, CompassCsvWritesHeadingsInZeroTo360) {
     w.write({.t_ns = 20, .heading_rad = std::numbers::pi / 4, .field_S_nt = Vec3(0, 0, 0)});
     w.commit();
   }
-  EXPECT_EQ(read_text(dir / "compass.csv"),
+  EXPECT_EQ(slurp(dir / "compass.csv"),
             "#timestamp [ns],heading [deg],m_S_x [nT],m_S_y [nT],m_S_z [nT]\n"
             "10,270,1,2.5,-3\n"
             "20,45,0,0,0\n");

@@ -5,6 +5,7 @@
 #include <memory>
 #include <utility>
 
+#include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "vo/dense/disparity.hpp"
 #include "vo/dense/photometric.hpp"
@@ -12,12 +13,6 @@
 namespace driftlab::vo {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 // Coarsest level side below which the alignment has too little to work with.
 constexpr int kMinLevelSidePx = 8;
@@ -116,26 +111,26 @@ VoResult DenseStereoOdometry::process(const StereoFrame& frame) {
   Impl& s = *impl_;
   detail::check_image(frame.left, s.rig.camera, "DenseStereoOdometry", "left");
   detail::check_image(frame.right, s.rig.camera, "DenseStereoOdometry", "right");
-  const auto t_start = Clock::now();
+  const auto t_start = SteadyClock::now();
   VoResult result;
   s.stats = {};
   Impl::FrameData& cur = *s.cur;
 
   // Image preparation: the pyramid of the current left image (target now, reference next).
-  auto t = Clock::now();
+  auto t = SteadyClock::now();
   cur.pyramid.build(frame.left, s.options.pyramid_blur_sigma_px,
                     s.options.pyramid_area_downscaling);
   s.stats.pyramid_ms = ms_since(t);
   result.times.detect_ms = s.stats.pyramid_ms;
 
   // Stereo correspondence: SGBM disparity of the current pair (refined).
-  t = Clock::now();
+  t = SteadyClock::now();
   s.stereo->compute(frame.left, frame.right, cur.pyramid.images.back(), &cur.disparity);
   s.stats.sgbm_ms = ms_since(t);
   result.times.match_ms = s.stats.sgbm_ms;
 
   // Eq. (1) points and Jacobians of the current pair, for the next call; its statistics now.
-  t = Clock::now();
+  t = SteadyClock::now();
   dense::build_reference(cur.pyramid, cur.disparity, s.rig.camera.fx * s.rig.baseline_m,
                          s.selection, &cur.ref);
   s.stats.reference_ms = ms_since(t);
@@ -173,7 +168,7 @@ VoResult DenseStereoOdometry::process(const StereoFrame& frame) {
     return finish("too few textured pixels with valid depth in the previous frame");
 
   // Step 2: Levenberg-Marquardt on Eq. (9), coarse to fine.
-  t = Clock::now();
+  t = SteadyClock::now();
   SE3 T_curr_prev =
       s.options.use_constant_velocity() && s.has_velocity ? s.last_T_curr_prev : SE3();
   const dense::AlignSummary a = s.aligner.align(prev.ref, cur.pyramid, s.align, &T_curr_prev);

@@ -8,6 +8,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
+#include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "vo/pnp/pnp_features.hpp"
 #include "vo/pnp/pnp_subpixel.hpp"
@@ -18,13 +19,6 @@ using pnp::FeatureSet;
 using pnp::IndexMatch;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
 
 // A previous-frame 3D point and the current left pixel it was matched to.
 struct Correspondences {
@@ -190,7 +184,7 @@ VoResult PnpStereoOdometry::process(const StereoFrame& frame) {
   Impl& s = *impl_;
   detail::check_image(frame.left, s.rig.camera, "PnpStereoOdometry", "left");
   detail::check_image(frame.right, s.rig.camera, "PnpStereoOdometry", "right");
-  const auto t_start = Clock::now();
+  const auto t_start = SteadyClock::now();
   VoResult result;
   s.stats = {};
 
@@ -207,7 +201,7 @@ VoResult PnpStereoOdometry::process(const StereoFrame& frame) {
   s.stats.left_features = static_cast<int>(s.left.size());
   s.stats.right_features = static_cast<int>(s.right.size());
 
-  auto t = Clock::now();
+  auto t = SteadyClock::now();
   s.build_stereo_points();
   s.stats.stereo_points = static_cast<int>(s.points1.size());
   double match_ms = ms_since(t);
@@ -240,7 +234,7 @@ VoResult PnpStereoOdometry::process(const StereoFrame& frame) {
     return finish("too few stereo points in the previous frame");
 
   // Step 4a: current left features against the previous pair's points, within a window.
-  t = Clock::now();
+  t = SteadyClock::now();
   pnp::MatchWindow w;
   w.row_band_px = s.options.max_image_motion_px;
   w.du_min_px = -s.options.max_image_motion_px;
@@ -266,7 +260,7 @@ VoResult PnpStereoOdometry::process(const StereoFrame& frame) {
 
   // Step 4b: PnP inside RANSAC. OpenCV draws samples from its thread-local RNG; seeding it from
   // our stream makes the draw a function of (scenario seed, frame index) only.
-  t = Clock::now();
+  t = SteadyClock::now();
   cv::theRNG().state = s.rng.next_u64() | 1u;  // a zero state would make OpenCV's RNG constant
   cv::Vec3d rvec(0.0, 0.0, 0.0), tvec(0.0, 0.0, 0.0);
   std::vector<int> ransac_inliers;

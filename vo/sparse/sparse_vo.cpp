@@ -7,6 +7,7 @@
 
 #include <opencv2/video/tracking.hpp>
 
+#include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "vo/sparse/circle_matcher.hpp"
 #include "vo/sparse/features.hpp"
@@ -18,17 +19,6 @@ namespace driftlab::vo {
 using sparse::CircleMatch;
 using sparse::ImageFeatures;
 using sparse::StereoPointMatch;
-
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-
-}  // namespace
 
 struct SparseStereoOdometry::Impl {
   Impl(const StereoRig& rig_in, const SparseVoOptions& options_in, Rng rng_in)
@@ -168,7 +158,7 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   Impl& s = *impl_;
   detail::check_image(frame.left, s.rig.camera, "SparseStereoOdometry", "left");
   detail::check_image(frame.right, s.rig.camera, "SparseStereoOdometry", "right");
-  const auto t_start = Clock::now();
+  const auto t_start = SteadyClock::now();
   VoResult result;
   s.circles.clear();
   s.infos.clear();
@@ -216,10 +206,10 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   SE3 prior_T_prev_curr;
   const SE3* prior = nullptr;
   if (s.options.two_stage_matching) {
-    auto t = Clock::now();
+    auto t = SteadyClock::now();
     s.matcher.match(s.l1, s.r1, s.l0, s.r0, /*coarse_only=*/true, nullptr, &s.circles);
     match_ms += ms_since(t);
-    t = Clock::now();
+    t = SteadyClock::now();
     s.to_points();
     const auto coarse = s.estimator.estimate(s.points, &s.rng);
     estimate_ms += ms_since(t);
@@ -232,11 +222,11 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
     prior_T_prev_curr = coarse.T_curr_prev.inverse();
     prior = &prior_T_prev_curr;
   }
-  auto t = Clock::now();
+  auto t = SteadyClock::now();
   s.matcher.match(s.l1, s.r1, s.l0, s.r0, /*coarse_only=*/false, prior, &s.circles);
   if (s.options.lk_refinement && !s.circles.empty()) s.lk_refine();
   match_ms += ms_since(t);
-  t = Clock::now();
+  t = SteadyClock::now();
   s.to_points();
   // RANSAC hypotheses start from the prior when there is one: fewer Gauss-Newton iterations.
   const auto est =
@@ -252,7 +242,7 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   SE3 T_prev_curr = est.T_curr_prev.inverse();
   if (!detail::is_finite(T_prev_curr)) return finish("motion estimate not finite");
   if (s.window_ba) {  // falls back to the frame-to-frame estimate when the window solve fails
-    t = Clock::now();
+    t = SteadyClock::now();
     T_prev_curr = s.window_ba->add_frame(s.circles, *est.inliers, T_prev_curr).T_prev_curr;
     result.times.estimate_ms += ms_since(t);
   }

@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "pipeline/run.hpp"
-#include "pipeline/sweep.hpp"
+#include "study/sweep.hpp"
 
-namespace driftlab::pipeline {
+namespace driftlab::study {
 
 struct JobRunOptions {
   bool force = false;             // run again even when done
@@ -24,7 +24,7 @@ struct JobRunOptions {
 struct JobRunResult {
   std::string id;
   bool skipped = false;  // already done
-  RunSummary run;
+  pipeline::RunSummary run;
   std::string brief() const;
 };
 
@@ -116,4 +116,4 @@ std::string resubmit_command(const SweepManifest& m, const SweepStatus& status,
 /// 0-based indices as Slurm array ranges: {0,1,2,5,7,8} -> "0-2,5,7-8".
 std::string array_ranges(const std::vector<std::size_t>& sorted_indices);
 
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::study

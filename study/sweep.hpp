@@ -23,7 +23,7 @@
 #include <utility>
 #include <vector>
 
-namespace driftlab::pipeline {
+namespace driftlab::study {
 
 enum class SweepDesign { kGrid, kZip, kRandom };
 constexpr auto enum_table(SweepDesign) {
@@ -214,4 +214,4 @@ bool in_shard(const SweepJob& job, const Shard& shard);
 /// YAML text of a value as a JSON value (number, bool, string, list, map).
 nlohmann::json yaml_text_to_json(const std::string& yaml_text);
 
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::study

@@ -1,4 +1,4 @@
-#include "pipeline/process.hpp"
+#include "core/process.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -14,7 +14,7 @@
 
 #include "core/error.hpp"
 
-namespace driftlab::pipeline {
+namespace driftlab {
 
 std::string ExitStatus::describe() const {
   if (exited) return fmt::format("exit code {}", code);
@@ -146,4 +146,4 @@ std::optional<std::filesystem::path> find_on_path(const std::string& name) {
 
 bool process_alive(pid_t pid) { return pid > 0 && (::kill(pid, 0) == 0 || errno == EPERM); }
 
-}  // namespace driftlab::pipeline
+}  // namespace driftlab

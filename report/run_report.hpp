@@ -9,7 +9,7 @@
 
 #include "core/trajectory_io.hpp"
 
-namespace driftlab::pipeline {
+namespace driftlab::report {
 
 struct PlotFile {
   std::string title;
@@ -21,21 +21,19 @@ struct NamedTrajectory {
   Trajectory trajectory;
 };
 
+struct PlotSet {
+  std::vector<PlotFile> files;  ///< none when gnuplot is missing or failed
+  std::string warning;          ///< why there are none
+};
+
 /// Writes the plot data (DIR/plots/data/*.dat), a gnuplot script (DIR/plots/plots.gp) and runs
-/// gnuplot on it. `sections_csv` is the content of sections.csv. Returns the plots made; when
-/// gnuplot is missing or fails, returns none and says why in `warning`.
-std::vector<PlotFile> make_plots(const std::filesystem::path& dir, const Trajectory& gt,
-                                 const std::vector<NamedTrajectory>& estimates,
-                                 const std::string& sections_csv, std::string* warning);
+/// gnuplot on it. `sections_csv` is the content of sections.csv.
+PlotSet make_plots(const std::filesystem::path& dir, const Trajectory& gt,
+                   const std::vector<NamedTrajectory>& estimates, const std::string& sections_csv);
 
 /// report.html: `markdown` (headings, paragraphs, pipe tables, as eval writes them) as HTML,
 /// followed by the plots.
 std::string report_html(const std::string& title, const std::string& markdown,
                         const std::vector<PlotFile>& plots);
 
-/// Runs `argv` (argv[0] looked up in PATH) in `cwd`, its output to `log`; returns the exit
-/// status, or -1 when it could not start.
-int run_program(const std::vector<std::string>& argv, const std::filesystem::path& cwd,
-                const std::filesystem::path& log);
-
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::report

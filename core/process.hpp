@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace driftlab::pipeline {
+namespace driftlab {
 
 /// What to start. `executable` is run as given (no PATH search; see find_on_path).
 struct ProcessSpec {
@@ -51,4 +51,4 @@ std::optional<std::filesystem::path> find_on_path(const std::string& name);
 /// True when a process with this pid exists on this machine (kill(pid, 0)).
 bool process_alive(pid_t pid);
 
-}  // namespace driftlab::pipeline
+}  // namespace driftlab

@@ -1,4 +1,4 @@
-#include "pipeline/regress_gate.hpp"
+#include "gate/gate.hpp"
 
 #include <fmt/format.h>
 
@@ -11,7 +11,7 @@
 #include "core/error.hpp"
 #include "core/yaml_io.hpp"
 
-namespace driftlab::pipeline {
+namespace driftlab::gate {
 namespace fs = std::filesystem;
 
 namespace {
@@ -434,4 +434,4 @@ Baseline updated_baseline(const Baseline& baseline, const GateResult& result) {
   return b;
 }
 
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::gate

@@ -1,5 +1,5 @@
-// The command line of sweeps and of the regression gate: `driftlab sweep ...`,
-// `driftlab regress`, and the `--manifest/--job/--shard` options of `driftlab run`.
+// The command line of studies: `driftlab sweep ...` and the
+// `--manifest/--job/--shard` options of `driftlab run`.
 // Kept apart from main.cpp, which only wires these in.
 #pragma once
 
@@ -12,10 +12,10 @@
 
 namespace driftlab::app {
 
-class SweepCommands {
+class StudyCommands {
  public:
-  /// Adds `sweep` (plan, run, status, merge, slurm-script) and `regress` to `app`.
-  explicit SweepCommands(CLI::App& app);
+  /// Adds `sweep` (plan, run, status, merge, slurm-script) to `app`.
+  explicit StudyCommands(CLI::App& app);
 
   /// Adds --manifest, --job, --shard and --parallel to the `run` subcommand,
   /// whose SCENARIO and --out are then required only without --manifest.
@@ -33,7 +33,6 @@ class SweepCommands {
   int status();
   int merge();
   int slurm_script();
-  int regress();
   int run_manifest();
 
   CLI::App* sweep_ = nullptr;
@@ -42,7 +41,6 @@ class SweepCommands {
   CLI::App* status_ = nullptr;
   CLI::App* merge_ = nullptr;
   CLI::App* slurm_ = nullptr;
-  CLI::App* regress_ = nullptr;
   CLI::App* run_cmd_ = nullptr;
 
   std::string sweep_file_, dir_, out_;
@@ -53,8 +51,6 @@ class SweepCommands {
   bool allow_missing_ = false, no_plots_ = false;
   std::string partition_, time_, driftlab_;
   std::size_t cpus_per_task_ = 1, max_parallel_ = 0, shards_ = 0;
-  std::string baseline_, results_, junit_;
-  bool update_ = false;
   std::string manifest_, job_, shard_;
   std::size_t run_parallel_ = 1;
   const bool* run_force_ = nullptr;

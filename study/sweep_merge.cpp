@@ -1,4 +1,4 @@
-#include "pipeline/sweep_merge.hpp"
+#include "study/sweep_merge.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -13,14 +13,19 @@
 #include <sstream>
 
 #include "core/atomic_file.hpp"
+#include "core/csv.hpp"
 #include "core/error.hpp"
+#include "core/file_io.hpp"
 #include "core/yaml_io.hpp"
 #include "eval/regression.hpp"
 #include "eval/stats.hpp"
-#include "pipeline/process.hpp"
+#include "core/process.hpp"
 #include "pipeline/scenario.hpp"
 
-namespace driftlab::pipeline {
+namespace driftlab::study {
+
+using pipeline::Scenario;
+using pipeline::parse_scenario;
 namespace fs = std::filesystem;
 
 const std::vector<RunMetric>& run_metrics() {
@@ -46,59 +51,10 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 std::string num(double v) { return std::isfinite(v) ? yaml::format_double(v) : std::string(); }
 
 nlohmann::ordered_json jnum(double v) {
   return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
-}
-
-// RFC 4180 cell: quoted when it holds a comma, quote or line break.
-std::string csv_cell(const std::string& s) {
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
-
-std::string csv_row(const std::vector<std::string>& cells) {
-  std::string out;
-  for (std::size_t i = 0; i < cells.size(); ++i) out += (i ? "," : "") + csv_cell(cells[i]);
-  return out + "\n";
-}
-
-std::vector<std::string> split_csv_line(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        cell += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        cell += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      cells.push_back(cell);
-      cell.clear();
-    } else {
-      cell += c;
-    }
-  }
-  cells.push_back(cell);
-  return cells;
 }
 
 struct Table {
@@ -108,7 +64,7 @@ struct Table {
 
 Table read_csv(const fs::path& path) {
   Table t;
-  std::istringstream in(read_all(path));
+  std::istringstream in(read_text_file(path, "CSV file"));
   std::string line;
   std::size_t line_no = 0;
   while (std::getline(in, line)) {
@@ -244,7 +200,7 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
     std::error_code ec;
     if (fs::exists(metrics_file, ec)) {
       try {
-        rd.metrics = nlohmann::json::parse(read_all(metrics_file));
+        rd.metrics = nlohmann::json::parse(read_text_file(metrics_file, "metrics.json"));
       } catch (const nlohmann::json::parse_error& e) {
         throw UserError(fmt::format("{}: not valid JSON ({}), expected the run's metrics",
                                     metrics_file.string(), e.what()));
@@ -345,7 +301,7 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
     std::vector<std::string> base_covariates{"v", "h", "f", "d"};
     try {
       const Scenario base =
-          parse_scenario(read_all(m.scenario_file()), m.scenario_file().string(), m.base_dir());
+          parse_scenario(read_text_file(m.scenario_file(), "scenario file"), m.scenario_file().string(), m.base_dir());
       base_covariates = base.eval.regression_covariates;
     } catch (const UserError&) {
       // The plan checked scenario.yaml; if it was edited since, the runs say what is there.
@@ -746,4 +702,4 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
   return out;
 }
 
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::study

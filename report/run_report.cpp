@@ -1,4 +1,4 @@
-#include "pipeline/report.hpp"
+#include "report/run_report.hpp"
 
 
 #include <array>
@@ -13,9 +13,10 @@
 #include "core/rotation.hpp"
 #include "core/time.hpp"
 #include "core/yaml_io.hpp"
-#include "pipeline/process.hpp"
+#include "core/csv.hpp"
+#include "report/gnuplot.hpp"
 
-namespace driftlab::pipeline {
+namespace driftlab::report {
 
 namespace {
 
@@ -42,20 +43,21 @@ std::string trajectory_dat(const Trajectory& tr, const Trajectory* gt) {
   return s;
 }
 
-std::vector<std::string> split(const std::string& line, char sep) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::istringstream in(line);
-  while (std::getline(in, cell, sep)) out.push_back(cell);
-  if (!line.empty() && line.back() == sep) out.emplace_back();
-  return out;
-}
-
 // gnuplot string literal (single quotes; a quote is doubled).
 std::string q(const std::string& s) {
   std::string out = "'";
   for (char c : s) out += c == '\'' ? std::string("''") : std::string(1, c);
   return out + "'";
+}
+
+// The cells of a Markdown table row's inside, split at '|'.
+std::vector<std::string> split_pipes(const std::string& text) {
+  std::vector<std::string> out;
+  std::string cell;
+  std::istringstream in(text);
+  while (std::getline(in, cell, '|')) out.push_back(cell);
+  if (!text.empty() && text.back() == '|') out.emplace_back();
+  return out;
 }
 
 std::string html_escape(const std::string& s) {
@@ -74,26 +76,9 @@ std::string html_escape(const std::string& s) {
 
 }  // namespace
 
-int run_program(const std::vector<std::string>& argv, const std::filesystem::path& cwd,
-                const std::filesystem::path& log) {
-  const auto exe = find_on_path(argv.at(0));
-  if (!exe) return -1;
-  ProcessSpec spec;
-  spec.executable = *exe;
-  spec.args.assign(argv.begin() + 1, argv.end());
-  spec.output_file = log;
-  spec.working_directory = cwd;
-  try {
-    const ExitStatus st = wait_process(spawn_process(spec));
-    return st.exited ? st.code : -1;
-  } catch (const UserError&) {
-    return -1;
-  }
-}
 
-std::vector<PlotFile> make_plots(const std::filesystem::path& dir, const Trajectory& gt,
-                                 const std::vector<NamedTrajectory>& estimates,
-                                 const std::string& sections_csv, std::string* warning) {
+PlotSet make_plots(const std::filesystem::path& dir, const Trajectory& gt,
+                   const std::vector<NamedTrajectory>& estimates, const std::string& sections_csv) {
   const std::filesystem::path plots = dir / "plots";
   std::filesystem::create_directories(plots / "data");
   write_file_atomic(plots / "data" / "groundtruth.dat", trajectory_dat(gt, nullptr));
@@ -106,7 +91,7 @@ std::vector<PlotFile> make_plots(const std::filesystem::path& dir, const Traject
   std::istringstream in(sections_csv);
   std::string line;
   std::getline(in, line);
-  const std::vector<std::string> header = split(line, ',');
+  const std::vector<std::string> header = split_csv_line(line);
   auto column = [&header](const std::string& name) {
     for (std::size_t i = 0; i < header.size(); ++i)
       if (header[i] == name) return static_cast<int>(i);
@@ -115,7 +100,7 @@ std::vector<PlotFile> make_plots(const std::filesystem::path& dir, const Traject
   const std::vector<std::string> cov_names = {"v", "h", "f", "d"};
   const int c_alg = column("algorithm"), c_p = column("p_m_per_m");
   while (std::getline(in, line)) {
-    const auto cells = split(line, ',');
+    const auto cells = split_csv_line(line);
     if (c_alg < 0 || c_p < 0 || cells.size() != header.size()) continue;
     const std::string& alg = cells[static_cast<std::size_t>(c_alg)];
     if (!section_rows.count(alg)) section_order.push_back(alg);
@@ -132,10 +117,13 @@ std::vector<PlotFile> make_plots(const std::filesystem::path& dir, const Traject
     write_file_atomic(plots / "data" / ("sections_" + alg + ".dat"),
                       "# p_m_per_m v h f d\n" + section_rows[alg]);
 
+  // Data files first: they are written whatever happens to gnuplot.
+  const GnuplotLookup lookup = find_gnuplot();
+  const std::string terminal = lookup.gnuplot ? lookup.gnuplot->terminal : "pngcairo";
   std::vector<PlotFile> made;
   std::string gp =
       "# Made by driftlab run; re-run with: cd plots && gnuplot plots.gp\n"
-      "set terminal pngcairo size 900,640 font ',10' noenhanced\n"
+      "set terminal " + terminal + " size 900,640 font ',10' noenhanced\n"
       "set grid\nset key outside right top\n";
   auto curves = [&](const std::string& using_gt, const std::string& using_est, bool with_gt) {
     std::string s;
@@ -217,14 +205,10 @@ std::vector<PlotFile> make_plots(const std::filesystem::path& dir, const Traject
                     "plots/covariates.png"});
   }
   write_file_atomic(plots / "plots.gp", gp);
-  const int rc = run_program({"gnuplot", "plots.gp"}, plots, plots / "gnuplot.log");
-  if (rc != 0) {
-    *warning = rc < 0 ? "gnuplot not found: no plots (install gnuplot-nox)"
-                      : fmt::format("gnuplot failed (exit {}): see plots/gnuplot.log", rc);
-    return {};
-  }
-  std::filesystem::remove(plots / "gnuplot.log");
-  return made;
+  if (!lookup.gnuplot) return {{}, lookup.warning + ": no plots"};
+  const GnuplotRun run = run_gnuplot(*lookup.gnuplot, plots, "plots.gp", "gnuplot.log");
+  if (!run.ok) return {{}, fmt::format("gnuplot failed ({}): see plots/gnuplot.log", run.failure)};
+  return {made, ""};
 }
 
 std::string report_html(const std::string& title, const std::string& markdown,
@@ -241,7 +225,7 @@ std::string report_html(const std::string& title, const std::string& markdown,
   auto cells = [](const std::string& l) {
     std::vector<std::string> out;
     std::string t = l.substr(1, l.size() > 1 && l.back() == '|' ? l.size() - 2 : l.size() - 1);
-    for (auto& c : split(t, '|')) {
+    for (auto& c : split_pipes(t)) {
       const auto b = c.find_first_not_of(' '), e = c.find_last_not_of(' ');
       out.push_back(b == std::string::npos ? "" : c.substr(b, e - b + 1));
     }
@@ -282,4 +266,4 @@ std::string report_html(const std::string& title, const std::string& markdown,
   return h + "</body></html>\n";
 }
 
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::report

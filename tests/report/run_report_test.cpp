@@ -1,32 +1,17 @@
-// Report pieces of a run: the progress line, Markdown tables to HTML, gnuplot plots.
-#include "pipeline/report.hpp"
+// Report pieces of a run: Markdown tables to HTML, gnuplot plots.
+#include "report/gnuplot.hpp"
+#include "report/run_report.hpp"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
-#include "pipeline/progress.hpp"
 
-namespace driftlab::pipeline {
+namespace driftlab::report {
 namespace {
 
 namespace fs = std::filesystem;
-
-TEST(Progress, LineShowsFramesRateAndEta) {
-  // 50 of 100 frames in 10 s: 5 frames/s, 10 s to go.
-  const std::string bar = Progress::line("render+vo", 50, 100, 10.0, true);
-  EXPECT_NE(bar.find("[############            ]"), std::string::npos) << bar;
-  EXPECT_NE(bar.find("50/100 frames"), std::string::npos) << bar;
-  EXPECT_NE(bar.find("5.0/s"), std::string::npos) << bar;
-  EXPECT_NE(bar.find("ETA 0:10"), std::string::npos) << bar;
-  const std::string plain = Progress::line("render+vo", 100, 100, 3725.0, false);
-  EXPECT_EQ(plain.find('['), std::string::npos) << plain;
-  EXPECT_NE(plain.find("elapsed 1:02:05"), std::string::npos) << plain;
-  EXPECT_NE(plain.find("ETA 0:00"), std::string::npos) << plain;
-  // Nothing done yet: no rate, no estimate.
-  EXPECT_NE(Progress::line("x", 0, 10, 0.0, false).find("ETA --:--"), std::string::npos);
-}
 
 TEST(ReportHtml, TablesHeadingsParagraphsAndEscaping) {
   const std::string md =
@@ -55,8 +40,9 @@ TEST(Plots, GnuplotDrawsEveryPlotOrSaysWhyNot) {
   const std::string sections =
       "algorithm,index,p_m_per_m,v,h,f,d\nsparse,0,0.1,0.5,1,100,20\nsparse,1,0.2,0.6,2,90,25\n"
       "sparse,2,0.15,0.55,1.5,95,22\n";
-  std::string warning;
-  const auto plots = make_plots(dir, gt, {{"sparse", est}}, sections, &warning);
+  const PlotSet made = make_plots(dir, gt, {{"sparse", est}}, sections);
+  const auto& plots = made.files;
+  const std::string& warning = made.warning;
   // The data files are written whatever happens to gnuplot.
   std::ifstream data(dir / "plots/data/sparse.dat");
   std::string header, first;
@@ -65,7 +51,7 @@ TEST(Plots, GnuplotDrawsEveryPlotOrSaysWhyNot) {
   EXPECT_EQ(header, "# t_s north_m east_m down_m yaw_deg pitch_deg roll_deg err3d_m");
   std::getline(data, first);  // frame 1: 0.01 m off the truth
   EXPECT_NE(first.rfind(" 0.01"), std::string::npos) << first;
-  if (run_program({"gnuplot", "--version"}, dir, dir / "v.log") != 0) {
+  if (!find_gnuplot().gnuplot) {
     EXPECT_TRUE(plots.empty());
     EXPECT_NE(warning.find("gnuplot"), std::string::npos);
     GTEST_SKIP() << "gnuplot not installed";
@@ -82,4 +68,4 @@ TEST(Plots, GnuplotDrawsEveryPlotOrSaysWhyNot) {
 }
 
 }  // namespace
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::report

@@ -1,4 +1,4 @@
-#include "pipeline/sweep.hpp"
+#include "study/sweep.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -13,34 +13,28 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/file_io.hpp"
 #include "core/rng.hpp"
 #include "core/yaml_io.hpp"
-#include "pipeline/process.hpp"
+#include "core/process.hpp"
 #include "pipeline/scenario.hpp"
 
 #ifndef DRIFTLAB_VERSION
 #define DRIFTLAB_VERSION "unknown"
 #endif
 
-namespace driftlab::pipeline {
+namespace driftlab::study {
+
+using pipeline::Scenario;
+using pipeline::load_scenario;
+using pipeline::parse_scenario;
+using pipeline::resolved_yaml;
 namespace fs = std::filesystem;
 
 namespace {
 
 constexpr std::size_t kMaxJobs = 1000000;  // a typo in a range should not plan a billion runs
 constexpr std::size_t kMaxErrors = 20;     // per plan: the first problems are the useful ones
-
-std::string read_text_file(const fs::path& path, const char* what) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw UserError(fmt::format("{}: no such {}", path.string(), what));
-  if (fs::is_directory(path, ec))
-    throw UserError(fmt::format("{}: is a directory, expected a {}", path.string(), what));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw UserError(fmt::format("{}: cannot open for reading", path.string()));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // YAML text of a node for a KEY=VALUE override: scalars as they are (quoted
 // when YAML needs it), lists and maps in flow style.
@@ -1100,4 +1094,4 @@ bool in_shard(const SweepJob& job, const Shard& shard) {
   return job.index % shard.count == shard.index;
 }
 
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::study

@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/sweep.hpp"
+#include "study/sweep.hpp"
 
-namespace driftlab::pipeline {
+namespace driftlab::study {
 
 struct MergeOptions {
   /// Regression covariates: columns of the pooled table (section covariates
@@ -68,4 +68,4 @@ const std::vector<RunMetric>& run_metrics();
 /// {mean, mean} when n < 2.
 std::pair<double, double> confidence_interval_95(double mean, double sd, std::size_t n);
 
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::study

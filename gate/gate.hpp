@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-namespace driftlab::pipeline {
+namespace driftlab::gate {
 
 enum class MetricDirection { kLower, kHigher, kBoth };
 constexpr auto enum_table(MetricDirection) {
@@ -106,4 +106,4 @@ GateResult check_baseline(const Baseline& baseline, const nlohmann::json& result
 /// naming the metrics the results lack (nothing is updated then).
 Baseline updated_baseline(const Baseline& baseline, const GateResult& result);
 
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::gate

@@ -2,7 +2,7 @@
 // seeds and parameter hashes, bad sweep files, job states and Slurm shards; and,
 // through the real `driftlab` binary, that a sweep merges to the same bytes
 // whether run with -j 2, as shards, or killed and resumed.
-#include "pipeline/sweep.hpp"
+#include "study/sweep.hpp"
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -23,26 +23,22 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "core/yaml_io.hpp"
-#include "pipeline/process.hpp"
-#include "pipeline/regress_gate.hpp"
+#include "core/process.hpp"
+#include "gate/gate.hpp"
 #include "pipeline/scenario.hpp"
-#include "pipeline/sweep_merge.hpp"
-#include "pipeline/sweep_runner.hpp"
+#include "study/sweep_merge.hpp"
+#include "study/sweep_runner.hpp"
+#include "tests/support/test_support.hpp"
 
-namespace driftlab::pipeline {
+namespace driftlab::study {
 namespace {
+
+using test::slurp;
 
 namespace fs = std::filesystem;
 const fs::path kSource = DRIFTLAB_SOURCE_DIR;
 const fs::path kCli = fs::path(DRIFTLAB_BINARY_DIR) / "bin" / "driftlab";
 const fs::path kSweeps = kSource / "tests/data/sweeps";
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 fs::path temp_dir(const std::string& name) {
   const fs::path d =
@@ -120,7 +116,7 @@ axes:
   EXPECT_EQ(param(plan.jobs[1], "water.waves.airy.wavelength_m"), "0.132");
   EXPECT_EQ(param(plan.jobs[2], "water.waves.airy.wavelength_m"), "0.059");
   // The fixed overrides are part of the base scenario of every job.
-  const Scenario sc = parse_scenario(plan.scenario_yaml, "scenario.yaml", kSweeps);
+  const pipeline::Scenario sc = pipeline::parse_scenario(plan.scenario_yaml, "scenario.yaml", kSweeps);
   EXPECT_EQ(sc.water.waves.model, sim::WaveModel::kAiry);
   EXPECT_EQ(sc.water.waves.water_depth_m, 0.6);
 }
@@ -249,7 +245,7 @@ axes:
     EXPECT_EQ(a.jobs[k].hash.size(), 16u);
     hashes.insert(a.jobs[k].hash);
     // What the hash covers: every parameter of the job's resolved scenario.
-    const Scenario sc = parse_scenario(a.scenario_yaml, "x", kSweeps, a.jobs[k].overrides);
+    const pipeline::Scenario sc = pipeline::parse_scenario(a.scenario_yaml, "x", kSweeps, a.jobs[k].overrides);
     EXPECT_EQ(a.jobs[k].hash, fnv1a64_hex(yaml::to_yaml(sc, false)));
   }
   EXPECT_EQ(hashes.size(), 4u);  // parameters or seed differ in every pair of jobs
@@ -441,7 +437,7 @@ TEST(SweepFiles, ShippedSweepsAndTheCiBaselineAreValid) {
     const SweepPlan plan = plan_sweep(load_sweep(f));
     EXPECT_GE(plan.jobs.size(), 4u);
   }
-  const Baseline b = load_baseline(kSource / "examples/ci/baseline.json");
+  const gate::Baseline b = gate::load_baseline(kSource / "examples/ci/baseline.json");
   EXPECT_GE(b.metrics.size(), 5u);
   for (const auto& m : b.metrics) EXPECT_TRUE(m.baseline.has_value()) << m.key;
 }
@@ -683,4 +679,4 @@ TEST(SweepCli, OneLocalRunnerAtATime) {
 }
 
 }  // namespace
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::study

@@ -1,4 +1,4 @@
-#include "app/sweep_commands.hpp"
+#include "app/study_commands.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -12,14 +12,13 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/yaml_io.hpp"
-#include "pipeline/regress_gate.hpp"
-#include "pipeline/sweep.hpp"
-#include "pipeline/sweep_merge.hpp"
-#include "pipeline/sweep_runner.hpp"
+#include "study/sweep.hpp"
+#include "study/sweep_merge.hpp"
+#include "study/sweep_runner.hpp"
 
 namespace driftlab::app {
 namespace fs = std::filesystem;
-namespace pl = driftlab::pipeline;
+namespace pl = driftlab::study;
 
 namespace {
 
@@ -38,13 +37,6 @@ std::string quote(const std::string& s) {
   return out + "'";
 }
 
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // Progress on stderr: redrawn in place on a terminal, a line per finished job otherwise.
 std::function<void(const pl::SweepProgress&)> progress_printer() {
   const bool tty = ::isatty(STDERR_FILENO) != 0;
@@ -60,7 +52,7 @@ std::function<void(const pl::SweepProgress&)> progress_printer() {
 
 }  // namespace
 
-SweepCommands::SweepCommands(CLI::App& app) {
+StudyCommands::StudyCommands(CLI::App& app) {
   sweep_ = app.add_subcommand("sweep", "Plan, run and merge scenario sweeps");
   sweep_->require_subcommand(1);
 
@@ -116,17 +108,9 @@ SweepCommands::SweepCommands(CLI::App& app) {
   slurm_->add_option("--driftlab", driftlab_,
                      "driftlab binary on the compute nodes (default: this one)");
 
-  regress_ = app.add_subcommand(
-      "regress", "Compare metrics with a baseline (CI regression gate); exit 1 on a regression");
-  regress_->add_option("--baseline", baseline_, "Baseline JSON (see docs/sweeps.md)")->required();
-  regress_->add_option("--results", results_, "Run folder, merged sweep folder, or a metrics.json")
-      ->required();
-  regress_->add_option("--junit", junit_, "Also write the verdicts as JUnit XML here");
-  regress_->add_flag("--update", update_,
-                     "Write the new values into the baseline (accept them) instead of failing");
 }
 
-void SweepCommands::add_run_options(CLI::App* run_cmd, CLI::Option* scenario, CLI::Option* out,
+void StudyCommands::add_run_options(CLI::App* run_cmd, CLI::Option* scenario, CLI::Option* out,
                                     const bool* force) {
   run_cmd_ = run_cmd;
   run_force_ = force;
@@ -160,18 +144,17 @@ void SweepCommands::add_run_options(CLI::App* run_cmd, CLI::Option* scenario, CL
   });
 }
 
-std::optional<int> SweepCommands::dispatch() {
+std::optional<int> StudyCommands::dispatch() {
   if (plan_->parsed()) return plan();
   if (run_->parsed()) return run_local();
   if (status_->parsed()) return status();
   if (merge_->parsed()) return merge();
   if (slurm_->parsed()) return slurm_script();
-  if (regress_->parsed()) return regress();
   if (run_cmd_ && run_cmd_->parsed() && !manifest_.empty()) return run_manifest();
   return std::nullopt;
 }
 
-int SweepCommands::plan() {
+int StudyCommands::plan() {
   const pl::Sweep sweep = pl::load_sweep(sweep_file_);
   const pl::SweepPlan plan = pl::plan_sweep(sweep);
   const pl::PlanWriteSummary s = pl::write_plan(plan, out_, force_);
@@ -183,7 +166,7 @@ int SweepCommands::plan() {
   return 0;
 }
 
-int SweepCommands::run_local() {
+int StudyCommands::run_local() {
   const pl::SweepManifest m = pl::read_manifest(dir_);
   pl::SweepRunOptions o;
   o.executable = self_executable();
@@ -202,7 +185,7 @@ int SweepCommands::run_local() {
   return 0;
 }
 
-int SweepCommands::status() {
+int StudyCommands::status() {
   const pl::SweepManifest m = pl::read_manifest(dir_);
   const pl::SweepStatus st = pl::sweep_status(m);
   std::cout << fmt::format("sweep {} in {}\n{}\n", m.info.value("name", ""), m.dir.string(),
@@ -245,7 +228,7 @@ int SweepCommands::status() {
   return 0;
 }
 
-int SweepCommands::merge() {
+int StudyCommands::merge() {
   const pl::SweepManifest m = pl::read_manifest(dir_);
   pl::MergeOptions o;
   o.covariates = covariates_;
@@ -258,7 +241,7 @@ int SweepCommands::merge() {
   return 0;
 }
 
-int SweepCommands::slurm_script() {
+int StudyCommands::slurm_script() {
   const pl::SweepManifest m = pl::read_manifest(dir_);
   pl::SlurmOptions o;
   o.partition = partition_;
@@ -272,37 +255,7 @@ int SweepCommands::slurm_script() {
   return 0;
 }
 
-int SweepCommands::regress() {
-  const pl::Baseline baseline = pl::load_baseline(baseline_);
-  const fs::path file = pl::find_results_metrics(results_);
-  nlohmann::json results;
-  try {
-    results = nlohmann::json::parse(read_all(file));
-  } catch (const nlohmann::json::parse_error& e) {
-    throw UserError(
-        fmt::format("{}: not valid JSON ({}), expected metrics.json", file.string(), e.what()));
-  }
-  const pl::GateResult r = pl::check_baseline(baseline, results, file);
-  std::cout << r.table();
-  if (!junit_.empty()) write_file_atomic(junit_, r.junit_xml());
-  if (update_) {
-    write_file_atomic(baseline_, pl::baseline_json(pl::updated_baseline(baseline, r)));
-    std::cout << fmt::format("regress: {}; baseline {} updated with the new values\n", r.brief(),
-                             baseline_);
-    return 0;
-  }
-  std::cout << "regress: " << r.brief() << "\n";
-  if (r.failures() > 0) {
-    std::cerr << fmt::format(
-        "error: {} of {} metrics regressed or are missing (compared {} with "
-        "{}); if the change is intended, accept it with --update\n",
-        r.failures(), r.checks.size(), file.string(), baseline_);
-    return 1;
-  }
-  return 0;
-}
-
-int SweepCommands::run_manifest() {
+int StudyCommands::run_manifest() {
   const pl::SweepManifest m = pl::read_manifest(manifest_);
   const bool force = run_force_ && *run_force_;
   if (!job_.empty()) {

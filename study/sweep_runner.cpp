@@ -1,4 +1,4 @@
-#include "pipeline/sweep_runner.hpp"
+#include "study/sweep_runner.hpp"
 
 #include <fcntl.h>
 #include <fmt/format.h>
@@ -16,15 +16,21 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/file_io.hpp"
 #include "core/yaml_io.hpp"
-#include "pipeline/process.hpp"
+#include "core/process.hpp"
 #include "pipeline/scenario.hpp"
 
 #ifndef DRIFTLAB_VERSION
 #define DRIFTLAB_VERSION "unknown"
 #endif
 
-namespace driftlab::pipeline {
+namespace driftlab::study {
+
+using pipeline::Scenario;
+using pipeline::parse_scenario;
+using pipeline::RunOptions;
+using pipeline::run_scenario;
 namespace fs = std::filesystem;
 
 namespace {
@@ -39,13 +45,6 @@ std::string host_name() {
   char buf[256] = {};
   if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
   return buf;
-}
-
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 // The last lines of a log (at most ~4 KB), for failure records.
@@ -145,7 +144,7 @@ JobRunResult run_manifest_job(const SweepManifest& m, const std::string& id,
           fmt::format("{}: no such file, expected the base scenario that `driftlab "
                       "sweep plan` wrote beside the manifest",
                       scenario_file.string()));
-    const Scenario sc = parse_scenario(read_all(scenario_file), scenario_file.string(),
+    const Scenario sc = parse_scenario(read_text_file(scenario_file, "scenario file"), scenario_file.string(),
                                        m.base_dir(), job.overrides);
     const std::string hash = fnv1a64_hex(yaml::to_yaml(sc, false));
     if (hash != job.hash)
@@ -291,7 +290,10 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
           ++summary.failed;
           ++progress.failed;
           summary.failed_ids.push_back(r.job->id);
-          const std::string log = read_all(m.log_file(r.job->id));
+          std::error_code log_ec;
+          const std::string log = fs::exists(m.log_file(r.job->id), log_ec)
+                                      ? read_text_file(m.log_file(r.job->id), "job log")
+                                      : std::string();
           std::string why =
               status->ok() ? "exit code 0 but no completion marker" : status->describe();
           progress.last_detail = why;
@@ -433,7 +435,7 @@ std::optional<SlurmScript> read_slurm_script(const SweepManifest& m) {
   std::error_code ec;
   if (!fs::exists(info, ec)) return std::nullopt;
   try {
-    const auto j = nlohmann::json::parse(read_all(info));
+    const auto j = nlohmann::json::parse(read_text_file(info, "Slurm record"));
     SlurmScript s;
     s.script = j.at("script").get<std::string>();
     s.shards = j.at("shards").get<std::size_t>();
@@ -463,4 +465,4 @@ std::string resubmit_command(const SweepManifest& m, const SweepStatus& status,
                      shell_quote(script.script.string()));
 }
 
-}  // namespace driftlab::pipeline
+}  // namespace driftlab::study

@@ -1,0 +1,29 @@
+// What every driftlab executable does around its commands: parse the command
+// line, run, and turn exceptions into the documented exit codes. Library code
+// throws; only this file maps errors to exit codes.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <stdexcept>
+
+namespace driftlab::app {
+
+constexpr int kExitOk = 0;
+constexpr int kExitUserError = 1;    // bad input: the message names file, line, key, value
+constexpr int kExitUsage = 2;        // bad command line
+constexpr int kExitUnavailable = 3;  // a stage this build does not have
+constexpr int kExitInternal = 4;     // a bug
+
+/// A subcommand whose stage this build does not have.
+struct Unavailable : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Parses argv into `app` and runs `dispatch`, mapping a bad command line to kExitUsage (after
+/// CLI11 printed why; --help and --version exit 0), UserError to kExitUserError, Unavailable
+/// to kExitUnavailable and any other exception to kExitInternal.
+int run_cli_main(CLI::App& app, int argc, char** argv, const std::function<int()>& dispatch);
+
+}  // namespace driftlab::app

@@ -1,0 +1,41 @@
+// Helpers shared by the test files: reading files, temporary folders, and
+// running the `driftlab` executable or a shell command as a user would.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace driftlab::test {
+
+/// The source tree (scenarios, tests/data) and the build tree (bin/driftlab).
+std::filesystem::path source_dir();
+std::filesystem::path binary_dir();
+/// build/bin/driftlab.
+std::filesystem::path cli_path();
+
+/// The whole file as bytes; "" when it cannot be read.
+std::string slurp(const std::filesystem::path& path);
+
+/// A path under the temporary folder, unique to this process and `name`, that does not exist.
+std::filesystem::path unused_temp_path(const std::string& name);
+/// The same path, created as an empty folder.
+std::filesystem::path fresh_temp_dir(const std::string& name);
+
+/// 'text' quoted for /bin/sh.
+std::string shell_quote(const std::string& text);
+
+struct CommandResult {
+  int exit_code = -1;  // -1: killed by a signal
+  std::string out;     // standard output
+  std::string err;     // standard error
+  std::string output;  // both, for searching messages
+};
+
+/// Runs build/bin/driftlab with `args`; `env` ("A=1 B=2") is put before the command.
+CommandResult run_cli(const std::vector<std::string>& args, const std::string& env = "");
+
+/// Runs a /bin/sh command line.
+CommandResult run_shell(const std::string& command);
+
+}  // namespace driftlab::test
