@@ -21,7 +21,6 @@ class GateCommand {
   int run();
 
  private:
-
   CLI::App* cmd_;
   std::string baseline_, results_, junit_;
   bool update_ = false;

@@ -1,11 +1,11 @@
 // The `driftlab` command line: declares the verbs and wires in the study and
 // gate commands; app/cli_main.cpp maps exceptions to the documented exit codes.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
+#include <unistd.h>
 #include <cstdio>
 #include <filesystem>
-#include <unistd.h>
 
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -32,12 +32,10 @@ namespace {
 using driftlab::UserError;
 namespace fs = std::filesystem;
 
-int scenario_check(const std::string& file, const std::vector<std::string>& overrides,
-                   bool quiet) {
+int scenario_check(const std::string& file, const std::vector<std::string>& overrides, bool quiet) {
   const auto scenario = driftlab::pipeline::load_scenario(file, overrides);
   if (!quiet) std::cout << driftlab::pipeline::resolved_yaml(scenario);
-  std::cerr << fmt::format("{}: OK (scenario '{}', seed {})\n", file, scenario.name,
-                           scenario.seed);
+  std::cerr << fmt::format("{}: OK (scenario '{}', seed {})\n", file, scenario.name, scenario.seed);
   return 0;
 }
 
@@ -112,8 +110,8 @@ int eval_command(const EvalArgs& a) {
   driftlab::AtomicDirectory dir(a.out, a.force);
   nlohmann::json metrics;
   metrics["version"] = DRIFTLAB_VERSION;
-  metrics["inputs"] = {{"gt", a.gt}, {"est", a.est}, {"format", a.format},
-                       {"covariates", a.covariates}};
+  metrics["inputs"] = {
+      {"gt", a.gt}, {"est", a.est}, {"format", a.format}, {"covariates", a.covariates}};
   metrics["algorithms"][e.algorithm] = eval::to_json(e, in.options);
   // The single algorithm's metrics also at the top level, for quick access.
   for (auto& [key, value] : metrics["algorithms"][e.algorithm].items()) metrics[key] = value;
@@ -192,8 +190,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   eval_cmd->add_option("--align-first-n", ev.align_first_n,
                        "Align on the first N poses only (0 = all)");
-  eval_cmd->add_option("--max-diff", ev.max_diff_s,
-                       "Largest stamp difference when pairing poses [s]")
+  eval_cmd
+      ->add_option("--max-diff", ev.max_diff_s, "Largest stamp difference when pairing poses [s]")
       ->capture_default_str();
   eval_cmd->add_option("--section-length", ev.section_length_m, "Section length [m]")
       ->capture_default_str();
@@ -220,7 +218,8 @@ int main(int argc, char** argv) {
     if (schema_cmd->parsed()) return scenario_schema(schema_out);
     if (const auto rc = study_commands.dispatch()) return *rc;
     if (const auto rc = gate_command.dispatch()) return *rc;
-    if (run_cmd->parsed()) return run_command(run_file, run_out, run_sets, run_seed, run_force, run_only_motion);
+    if (run_cmd->parsed())
+      return run_command(run_file, run_out, run_sets, run_seed, run_force, run_only_motion);
     if (render_cmd->parsed()) {
       const auto scenario = driftlab::pipeline::load_scenario(render_file, render_sets);
       driftlab::pipeline::RenderSequenceOptions ro;

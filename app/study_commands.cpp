@@ -107,7 +107,6 @@ StudyCommands::StudyCommands(CLI::App& app) {
                      "MaxArraySize is 1001)");
   slurm_->add_option("--driftlab", driftlab_,
                      "driftlab binary on the compute nodes (default: this one)");
-
 }
 
 void StudyCommands::add_run_options(CLI::App* run_cmd, CLI::Option* scenario, CLI::Option* out,

@@ -34,8 +34,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/rgbd.hpp>
 
-#include "core/stopwatch.hpp"
 #include "core/rng.hpp"
+#include "core/stopwatch.hpp"
 #include "tests/vo/vo_test_sequences.hpp"
 #include "vo/dense/dense_vo.hpp"
 #include "vo/dense/disparity.hpp"

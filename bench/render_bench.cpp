@@ -18,8 +18,8 @@ namespace {
 using namespace driftlab;
 
 void render_bench(benchmark::State& state, const char* scenario_file, bool basin) {
-  pipeline::Scenario sc = pipeline::load_scenario(
-      std::filesystem::path(DRIFTLAB_SOURCE_DIR) / "scenarios" / scenario_file);
+  pipeline::Scenario sc = pipeline::load_scenario(std::filesystem::path(DRIFTLAB_SOURCE_DIR) /
+                                                  "scenarios" / scenario_file);
   sc.sensors.camera.width_px = static_cast<int>(state.range(0));
   sc.sensors.camera.height_px = static_cast<int>(state.range(1));
   sc.sensors.camera.fx_px = sc.sensors.camera.fy_px = 0.78 * state.range(0);
@@ -28,29 +28,37 @@ void render_bench(benchmark::State& state, const char* scenario_file, bool basin
   const sim::SceneGeometry scene = scenes::build_scene(sc.scene, sc.seed, -10, 60);
   sim::StereoRenderer renderer(pipeline::rig_of(sc.sensors.camera), sc.render);
   renderer.upload(scene);
-  renderer.set_waves(sim::wave_components(sc.water.waves, RngStreams(sc.seed).stream("waves.phases")));
+  renderer.set_waves(
+      sim::wave_components(sc.water.waves, RngStreams(sc.seed).stream("waves.phases")));
   // A camera 0.5 m above the water looking along the river, slowly moving.
   double t = 0;
   for (auto _ : state) {
     const double x = basin ? 0.5 + 0.1 * t : 0.6 * t;
-    const SE3 T_W_C(quat_from_euler_zyx({0, 0, basin ? 0.0 : 0.5}) *
-                        Quat(R_frd_optical()),
+    const SE3 T_W_C(quat_from_euler_zyx({0, 0, basin ? 0.0 : 0.5}) * Quat(R_frd_optical()),
                     Vec3(x, 0, -0.5));
     benchmark::DoNotOptimize(renderer.render(T_W_C, t, false));
     t += 1.0 / 13;
   }
-  state.counters["pairs_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()),
-                                                     benchmark::Counter::kIsRate);
+  state.counters["pairs_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["triangles"] = static_cast<double>(renderer.triangles());
 }
 
 void BM_RenderRiverReach(benchmark::State& state) {
   render_bench(state, "river_crossing.yaml", false);
 }
-BENCHMARK(BM_RenderRiverReach)->Args({640, 480})->Args({1024, 768})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderRiverReach)
+    ->Args({640, 480})
+    ->Args({1024, 768})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_RenderWaveBasin(benchmark::State& state) { render_bench(state, "basin_exp4.yaml", true); }
-BENCHMARK(BM_RenderWaveBasin)->Args({640, 480})->Args({1024, 768})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderWaveBasin)
+    ->Args({640, 480})
+    ->Args({1024, 768})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 

@@ -2,8 +2,7 @@
 
 namespace driftlab::detail {
 
-void throw_internal(const char* condition, const char* file, int line,
-                    const std::string& message) {
+void throw_internal(const char* condition, const char* file, int line, const std::string& message) {
   std::string what = std::string("internal error: ") + file + ":" + std::to_string(line) +
                      ": check failed: " + condition;
   if (!message.empty()) what += ": " + message;

@@ -29,17 +29,15 @@ namespace detail {
 }  // namespace driftlab
 
 /// Always-on check for impossible states (Drake's DRAKE_DEMAND). Throws InternalError.
-#define DRIFTLAB_DEMAND(condition)                                              \
-  do {                                                                          \
-    if (!(condition))                                                           \
-      ::driftlab::detail::throw_internal(#condition, __FILE__, __LINE__, "");   \
+#define DRIFTLAB_DEMAND(condition)                                                            \
+  do {                                                                                        \
+    if (!(condition)) ::driftlab::detail::throw_internal(#condition, __FILE__, __LINE__, ""); \
   } while (0)
 
 /// Always-on check with a message.
-#define DRIFTLAB_DEMAND_MSG(condition, message)                                    \
-  do {                                                                             \
-    if (!(condition))                                                              \
-      ::driftlab::detail::throw_internal(#condition, __FILE__, __LINE__, message); \
+#define DRIFTLAB_DEMAND_MSG(condition, message)                                                    \
+  do {                                                                                             \
+    if (!(condition)) ::driftlab::detail::throw_internal(#condition, __FILE__, __LINE__, message); \
   } while (0)
 
 /// Debug-only invariant (Drake's DRAKE_ASSERT); compiled out under NDEBUG.

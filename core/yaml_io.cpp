@@ -216,8 +216,8 @@ void Reader::check_number(const YAML::Node& node, const std::string& key_path, d
   const bool low = check.lo_open ? !(v > check.lo) : !(v >= check.lo);
   const bool high = check.hi_open ? !(v < check.hi) : !(v <= check.hi);
   if (low || high) {
-    Check bounds{.lo = check.lo, .hi = check.hi, .lo_open = check.lo_open,
-                 .hi_open = check.hi_open};
+    Check bounds{
+        .lo = check.lo, .hi = check.hi, .lo_open = check.lo_open, .hi_open = check.hi_open};
     fail(node, key_path, format_double(v), "a value " + bounds.describe());
   }
 }
@@ -253,8 +253,8 @@ void Reader::finish() {
         if (entries_[j].first.IsScalar() && entries_[j].first.Scalar() == name)
           first_occurrence = false;
       if (!first_occurrence)
-        errors_->add(fmt::format("{}: {}: duplicate key, expected each key once", where(key),
-                                 path(name)));
+        errors_->add(
+            fmt::format("{}: {}: duplicate key, expected each key once", where(key), path(name)));
       continue;
     }
     if (std::find(seen_.begin(), seen_.end(), name) != seen_.end()) continue;
@@ -286,8 +286,8 @@ YAML::Node load_string(const std::string& text, const std::string& label) {
   try {
     YAML::Node node = YAML::Load(text);
     if (!node || node.IsNull())
-      throw UserError(fmt::format("{}: the document is empty, expected a mapping of keys to values",
-                                  label));
+      throw UserError(
+          fmt::format("{}: the document is empty, expected a mapping of keys to values", label));
     return node;
   } catch (const YAML::ParserException& e) {
     throw UserError(fmt::format("{}:{}:{}: YAML syntax error: {}", label, e.mark.line + 1,
@@ -331,9 +331,9 @@ YAML::Node override_document(const std::string& assignment) {
 // Writer
 
 std::string quote_string(const std::string& s) {
-  static const char* kReserved[] = {"",     "~",     "null", "Null", "NULL", "true", "True",
-                                    "TRUE", "false", "False", "FALSE", "yes", "no",  "on",
-                                    "off",  "Yes",   "No",   "On",   "Off"};
+  static const char* kReserved[] = {"",     "~",     "null",  "Null",  "NULL", "true", "True",
+                                    "TRUE", "false", "False", "FALSE", "yes",  "no",   "on",
+                                    "off",  "Yes",   "No",    "On",    "Off"};
   bool plain = std::find(std::begin(kReserved), std::end(kReserved), s) == std::end(kReserved);
   double d;
   if (plain && parse_double(s, &d)) plain = false;
@@ -391,10 +391,10 @@ void Validator::check_double(const std::string& key_path, double v, const Check&
   const bool low = check.lo_open ? !(v > check.lo) : !(v >= check.lo);
   const bool high = check.hi_open ? !(v < check.hi) : !(v <= check.hi);
   if (low || high) {
-    Check bounds{.lo = check.lo, .hi = check.hi, .lo_open = check.lo_open,
-                 .hi_open = check.hi_open};
-    errors_->add(
-        fmt::format("{}: got {}, expected a value {}", key_path, format_double(v), bounds.describe()));
+    Check bounds{
+        .lo = check.lo, .hi = check.hi, .lo_open = check.lo_open, .hi_open = check.hi_open};
+    errors_->add(fmt::format("{}: got {}, expected a value {}", key_path, format_double(v),
+                             bounds.describe()));
   }
 }
 

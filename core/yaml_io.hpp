@@ -69,7 +69,9 @@ inline Check at_most(double v) { return {.hi = v}; }
 inline Check in_range(double lo, double hi) { return {.lo = lo, .hi = hi}; }
 inline Check unit_interval() { return in_range(0.0, 1.0); }
 inline Check min_size(std::size_t n) { return {.min_size = n}; }
-inline Check size_between(std::size_t lo, std::size_t hi) { return {.min_size = lo, .max_size = hi}; }
+inline Check size_between(std::size_t lo, std::size_t hi) {
+  return {.min_size = lo, .max_size = hi};
+}
 inline Check non_empty() { return {.min_size = 1, .non_empty_string = true}; }
 
 // ---------------------------------------------------------------------------
@@ -88,7 +90,9 @@ struct is_std_array<std::array<T, N>> : std::true_type {};
 struct ProbeArchive;  // used only to detect visitable structs
 
 template <class T>
-concept Visitable = requires(T& t, ProbeArchive& a) { t.visit(a); };
+concept Visitable = requires(T& t, ProbeArchive& a) {
+  t.visit(a);
+};
 
 template <class T>
 struct is_vector_of_visitable : std::false_type {};
@@ -96,7 +100,9 @@ template <Visitable T, class Alloc>
 struct is_vector_of_visitable<std::vector<T, Alloc>> : std::true_type {};
 
 template <class T>
-concept Enum = std::is_enum_v<T> && requires(T e) { enum_table(e); };
+concept Enum = std::is_enum_v<T> && requires(T e) {
+  enum_table(e);
+};
 
 /// Name of an enum value from its ADL enum_table.
 template <Enum E>
@@ -206,8 +212,8 @@ class Reader {
   void read_value(const YAML::Node& node, const std::string& key_path, T& value,
                   const Check& check);
 
-  bool read_scalar_text(const YAML::Node& node, const std::string& key_path,
-                        const char* expected, std::string* text);
+  bool read_scalar_text(const YAML::Node& node, const std::string& key_path, const char* expected,
+                        std::string* text);
   void check_number(const YAML::Node& node, const std::string& key_path, double v,
                     const Check& check);
 
@@ -480,7 +486,8 @@ class Validator {
 
 template <class T>
 void Validator::check_value(const std::string& key_path, const T& value, const Check& check) {
-  if constexpr (std::is_floating_point_v<T> || (std::is_integral_v<T> && !std::is_same_v<T, bool>)) {
+  if constexpr (std::is_floating_point_v<T> ||
+                (std::is_integral_v<T> && !std::is_same_v<T, bool>)) {
     check_double(key_path, static_cast<double>(value), check);
   } else if constexpr (std::is_same_v<T, std::string>) {
     if (check.non_empty_string && value.empty())
@@ -587,8 +594,8 @@ void SchemaBuilder::add(const char* key, const T& value, const char* doc, const 
     SchemaBuilder sub(key_path, rows_);
     const_cast<T&>(value).visit(sub);
   } else if constexpr (is_vector_of_visitable<T>::value) {
-    rows_->push_back({key_path, "list of mappings", value.empty() ? "[]" : "(see scenario)", "",
-                      doc});
+    rows_->push_back(
+        {key_path, "list of mappings", value.empty() ? "[]" : "(see scenario)", "", doc});
     typename T::value_type element{};
     SchemaBuilder sub(key_path + "[]", rows_);
     element.visit(sub);

@@ -50,8 +50,8 @@ struct EvalOptions {
 
   template <class A>
   void visit(A& a) {
-    a("section_length_m", section_length_m,
-      "Length of the sections of river paper Section 2.4 [m]", yaml::positive());
+    a("section_length_m", section_length_m, "Length of the sections of river paper Section 2.4 [m]",
+      yaml::positive());
     a("align", align, "Alignment of estimate to ground truth before ATE");
     a("align_first_n", align_first_n, "Align on the first N poses only (0 = whole track)",
       yaml::non_negative());

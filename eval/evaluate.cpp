@@ -33,10 +33,11 @@ void regress(const EvalOptions& options, Evaluation* e) {
         available += (available.empty() ? "" : ", ") + n;
     std::string list;
     for (const auto& m : missing) list += (list.empty() ? "" : ", ") + m;
-    e->regression_skipped = fmt::format(
-        "covariate(s) {} not available{}", list,
-        available.empty() ? " (no sections)" : "; available: " + available +
-                                                   " (f and d need per-frame VO statistics)");
+    e->regression_skipped =
+        fmt::format("covariate(s) {} not available{}", list,
+                    available.empty()
+                        ? " (no sections)"
+                        : "; available: " + available + " (f and d need per-frame VO statistics)");
     return;
   }
   std::vector<double> y;
@@ -53,9 +54,9 @@ void regress(const EvalOptions& options, Evaluation* e) {
     for (std::size_t k = 0; k < names.size(); ++k) columns[k].push_back(s.covariate(names[k]));
   }
   if (dropped)
-    e->warnings.push_back(fmt::format(
-        "regression: {} of {} sections lack a covariate value and were left out", dropped,
-        e->sections.size()));
+    e->warnings.push_back(
+        fmt::format("regression: {} of {} sections lack a covariate value and were left out",
+                    dropped, e->sections.size()));
   if (y.size() < names.size() + 2) {
     e->regression_skipped =
         fmt::format("got {} sections, need at least {} for {} covariates and an intercept",
@@ -78,8 +79,8 @@ Evaluation evaluate(const EvaluationInput& in) {
   e.algorithm = in.algorithm;
   e.gt_poses = in.gt.size();
   e.est_poses = in.est.size();
-  e.association = associate(in.gt, in.est, seconds_to_ns(opt.association_tolerance_s),
-                            in.gt_label, in.est_label);
+  e.association = associate(in.gt, in.est, seconds_to_ns(opt.association_tolerance_s), in.gt_label,
+                            in.est_label);
   std::vector<TimeNs> t;
   std::vector<SE3> gt, est;
   for (std::size_t k = 0; k < e.association.size(); ++k) {
@@ -134,9 +135,10 @@ Evaluation evaluate(const EvaluationInput& in) {
     for (const auto& name : e.sections.front().covariate_names)
       e.covariates.emplace_back(name, summarize_covariate(e.sections, name));
   if (e.sections.empty())
-    e.warnings.push_back(fmt::format("the ground-truth track ({:.3f} m) is shorter than one "
-                                     "section of {} m: no section errors",
-                                     path_length_m(gt), opt.section_length_m));
+    e.warnings.push_back(
+        fmt::format("the ground-truth track ({:.3f} m) is shorter than one "
+                    "section of {} m: no section errors",
+                    path_length_m(gt), opt.section_length_m));
   regress(opt, &e);
 
   // Basin paper table: planar states of the camera, truth vs aligned estimate.
@@ -145,9 +147,9 @@ Evaluation evaluate(const EvaluationInput& in) {
 }
 
 std::string Evaluation::brief() const {
-  std::string s = fmt::format("{}: {} pairs, APE RMSE {:.4f} m, track RMSE 3D {:.4f} m ({:.2f} %)",
-                              algorithm, association.size(), ape.trans_m.rmse, track.rmse_3d_m,
-                              track.rmse_3d_pct);
+  std::string s =
+      fmt::format("{}: {} pairs, APE RMSE {:.4f} m, track RMSE 3D {:.4f} m ({:.2f} %)", algorithm,
+                  association.size(), ape.trans_m.rmse, track.rmse_3d_m, track.rmse_3d_pct);
   s += fmt::format(", {} sections (mean e'_p {:.4f} m/m)", sections.size(),
                    section_summary.p_m_per_m.mean);
   if (regression)
@@ -168,8 +170,8 @@ class JsonBuilder {
 
   nlohmann::json number(double v, const std::string& key) {
     if (std::isfinite(v)) return v;
-    warnings_->push_back(fmt::format("{} is not finite ({}); written as null", key,
-                                     yaml::format_double(v)));
+    warnings_->push_back(
+        fmt::format("{} is not finite ({}); written as null", key, yaml::format_double(v)));
     return nullptr;
   }
 
@@ -227,8 +229,7 @@ nlohmann::json to_json(const Evaluation& e, const EvalOptions& options) {
   j["alignment"] = {{"method", std::string(yaml::enum_name(options.align))},
                     {"first_n", options.align_first_n},
                     {"rotation", R},
-                    {"translation_m",
-                     {e.alignment.t.x(), e.alignment.t.y(), e.alignment.t.z()}},
+                    {"translation_m", {e.alignment.t.x(), e.alignment.t.y(), e.alignment.t.z()}},
                     {"scale", e.alignment.scale}};
   j["ape"]["trans_m"] = b.summary(e.ape.trans_m, "ape.trans_m", false);
   j["ape"]["rot_deg"] = b.summary(e.ape.rot_deg, "ape.rot_deg", false);
@@ -239,7 +240,8 @@ nlohmann::json to_json(const Evaluation& e, const EvalOptions& options) {
   j["rpe"]["rot_deg"] = b.summary(e.rpe.rot_deg, "rpe.rot_deg", false);
   j["track"] = b.track(e.track, "track");
   j["subtracks"] = nlohmann::json::object();
-  for (const auto& s : e.subtracks) j["subtracks"][s.name] = b.track(s.track, "subtracks." + s.name);
+  for (const auto& s : e.subtracks)
+    j["subtracks"][s.name] = b.track(s.track, "subtracks." + s.name);
 
   const SectionSummary& ss = e.section_summary;
   j["sections"] = {{"section_length_m", options.section_length_m}, {"count", e.sections.size()}};
@@ -327,13 +329,12 @@ std::string sections_csv(const Evaluation& e) {
   for (const auto& s : e.sections) {
     const double roll = rad2deg(s.err_rad.roll_rad), pitch = rad2deg(s.err_rad.pitch_rad),
                  yaw = rad2deg(s.err_rad.yaw_rad);
-    out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", e.algorithm,
-                       s.index, format_seconds(s.t_start_ns), format_seconds(s.t_end_ns),
-                       num(s.length_m), num(s.err_m.x()), num(s.err_m.y()), num(s.err_m.z()),
-                       num(s.err_p_m), num(roll), num(pitch), num(yaw), num(s.per_m(s.err_m.x())),
-                       num(s.per_m(s.err_m.y())), num(s.per_m(s.err_m.z())),
-                       num(s.per_m(s.err_p_m)), num(s.per_m(roll)), num(s.per_m(pitch)),
-                       num(s.per_m(yaw)));
+    out += fmt::format(
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", e.algorithm, s.index,
+        format_seconds(s.t_start_ns), format_seconds(s.t_end_ns), num(s.length_m), num(s.err_m.x()),
+        num(s.err_m.y()), num(s.err_m.z()), num(s.err_p_m), num(roll), num(pitch), num(yaw),
+        num(s.per_m(s.err_m.x())), num(s.per_m(s.err_m.y())), num(s.per_m(s.err_m.z())),
+        num(s.per_m(s.err_p_m)), num(s.per_m(roll)), num(s.per_m(pitch)), num(s.per_m(yaw)));
     for (double c : s.covariates) out += "," + num(c);
     out += "\n";
   }
@@ -373,10 +374,12 @@ std::string tables_markdown(const Evaluation& e, const EvalOptions& options) {
   md += summary_row("ε'_pitch", ss.pitch_deg_per_m, 2, false);
   md += summary_row("ε'_yaw", ss.yaw_deg_per_m, 2, false);
 
-  md += "\n## Table 2. RMSE and maximum of the 3D and 2D position errors, m (% of track "
-        "length) (river paper Table 2)\n\n";
-  md += "| track | 3D RMSE | 3D max | 2D RMSE | 2D max | N | length error |\n"
-        "|---|---|---|---|---|---|---|\n";
+  md +=
+      "\n## Table 2. RMSE and maximum of the 3D and 2D position errors, m (% of track "
+      "length) (river paper Table 2)\n\n";
+  md +=
+      "| track | 3D RMSE | 3D max | 2D RMSE | 2D max | N | length error |\n"
+      "|---|---|---|---|---|---|---|\n";
   auto track_row = [&](const std::string& name, const TrackErrors& t) {
     return fmt::format("| {} | {} ({}) | {} ({}) | {} ({}) | {} ({}) | {} | {} % |\n", name,
                        fixed(t.rmse_3d_m, 2), fixed(t.rmse_3d_pct, 2), fixed(t.max_3d_m, 2),
@@ -387,8 +390,9 @@ std::string tables_markdown(const Evaluation& e, const EvalOptions& options) {
   md += track_row("total trajectory", e.track);
   for (const auto& s : e.subtracks) md += track_row(s.name, s.track);
 
-  md += "\n## Table 3. Multiple linear regression of ε'_p on the covariates (river paper "
-        "Table 3); * marks significance at α = 0.05\n\n";
+  md +=
+      "\n## Table 3. Multiple linear regression of ε'_p on the covariates (river paper "
+      "Table 3); * marks significance at α = 0.05\n\n";
   if (e.regression) {
     const OlsResult& r = *e.regression;
     md += "| term | β | SE | t | p-value (t) | VIF |\n|---|---|---|---|---|---|\n";
@@ -396,8 +400,9 @@ std::string tables_markdown(const Evaluation& e, const EvalOptions& options) {
       md += fmt::format("| {} | {:.2e} | {:.2e} | {:.2f} | {:.2f}{} | {} |\n", c.name, c.estimate,
                         c.std_error, c.t, c.p, c.significant ? " *" : "",
                         c.name == "Intercept" || c.name == "intercept" ? "" : fixed(c.vif, 2));
-    md += fmt::format("\nF = {:.2f}, p-value (F) = {:.3g}, R² = {:.2f}, adjusted R² = {:.2f}, n = {}\n",
-                      r.f, r.f_p, r.r2, r.adj_r2, r.n);
+    md += fmt::format(
+        "\nF = {:.2f}, p-value (F) = {:.3g}, R² = {:.2f}, adjusted R² = {:.2f}, n = {}\n", r.f,
+        r.f_p, r.r2, r.adj_r2, r.n);
     const OlsDiagnostics& d = r.diagnostics;
     md += fmt::format(
         "\nResidual checks: Jarque-Bera {:.2f} (p {:.3f}); Shapiro-Wilk W {:.3f} (p {:.3f}); "
@@ -408,13 +413,15 @@ std::string tables_markdown(const Evaluation& e, const EvalOptions& options) {
     md += "Not computed: " + e.regression_skipped + "\n";
   }
 
-  md += "\n## Table 4. Distribution of the regression covariates over the sections (river "
-        "paper Table 4)\n\n";
+  md +=
+      "\n## Table 4. Distribution of the regression covariates over the sections (river "
+      "paper Table 4)\n\n";
   md += "| covariate | Min | Mean | Median | SD | Max | n |\n|---|---|---|---|---|---|---|\n";
   for (const auto& [name, s] : e.covariates) md += summary_row(name, s, 2, true);
 
-  md += "\n## Basin paper table: RMSE and standard deviation of the errors (Kučić and Valčić "
-        "2020, Tables 2-3)\n\n";
+  md +=
+      "\n## Basin paper table: RMSE and standard deviation of the errors (Kučić and Valčić "
+      "2020, Tables 2-3)\n\n";
   md += "| quantity | RMSE | std |\n|---|---|---|\n";
   md += fmt::format("| N (cm) | {} | {} |\n", fixed(e.basin.north_m.rmse * 100, 3),
                     fixed(e.basin.north_m.sd_sample * 100, 3));
@@ -427,8 +434,9 @@ std::string tables_markdown(const Evaluation& e, const EvalOptions& options) {
   md += fmt::format("| ψ (deg) | {} | {} |\n", fixed(e.basin.heading_deg.rmse, 3),
                     fixed(e.basin.heading_deg.sd_sample, 3));
 
-  md += "\n## Standard metrics\n\n| metric | RMSE | mean | median | std | max |\n"
-        "|---|---|---|---|---|---|\n";
+  md +=
+      "\n## Standard metrics\n\n| metric | RMSE | mean | median | std | max |\n"
+      "|---|---|---|---|---|---|\n";
   auto std_row = [&](const std::string& name, const Summary& s) {
     return fmt::format("| {} | {} | {} | {} | {} | {} |\n", name, fixed(s.rmse, 4),
                        fixed(s.mean, 4), fixed(s.median, 4), fixed(s.std_population, 4),
@@ -439,8 +447,9 @@ std::string tables_markdown(const Evaluation& e, const EvalOptions& options) {
   md += std_row("RPE translation (m)", e.rpe.trans_m);
   md += std_row("RPE rotation (deg)", e.rpe.rot_deg);
   if (!e.kitti.empty()) {
-    md += "\n| KITTI segment (m) | count | translation error (%) | rotation error (deg/100 m) |\n"
-          "|---|---|---|---|\n";
+    md +=
+        "\n| KITTI segment (m) | count | translation error (%) | rotation error (deg/100 m) |\n"
+        "|---|---|---|---|\n";
     for (const auto& k : e.kitti)
       md += fmt::format("| {} | {} | {} | {} |\n", yaml::format_double(k.length_m), k.count,
                         fixed(k.trans_err_pct, 3), fixed(k.rot_err_deg_per_100m, 3));

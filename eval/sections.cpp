@@ -64,7 +64,8 @@ FrameTable read_frame_table(const std::string& path) {
     header = split_csv_line(line, CsvTrim::kSpaces);
     break;
   }
-  if (header.empty()) throw UserError(fmt::format("{}: no header line, expected CSV with a header", path));
+  if (header.empty())
+    throw UserError(fmt::format("{}: no header line, expected CSV with a header", path));
   int time_col = -1;
   bool time_in_ns = false;
   FrameTable table;
@@ -73,7 +74,8 @@ FrameTable read_frame_table(const std::string& path) {
     if (header[c] == "t_ns" || header[c] == "t" || header[c] == "t_s") {
       if (time_col >= 0)
         throw UserError(fmt::format("{}:{}: two time columns ('{}' and '{}'), expected one", path,
-                                    line_no, header[static_cast<std::size_t>(time_col)], header[c]));
+                                    line_no, header[static_cast<std::size_t>(time_col)],
+                                    header[c]));
       time_col = static_cast<int>(c);
       time_in_ns = header[c] == "t_ns";
     } else {
@@ -84,8 +86,8 @@ FrameTable read_frame_table(const std::string& path) {
     }
   }
   if (time_col < 0)
-    throw UserError(fmt::format("{}:{}: no time column, expected one named t_ns, t or t_s", path,
-                                line_no));
+    throw UserError(
+        fmt::format("{}:{}: no time column, expected one named t_ns, t or t_s", path, line_no));
   table.columns.resize(table.names.size());
   while (std::getline(in, line)) {
     ++line_no;
@@ -103,10 +105,10 @@ FrameTable read_frame_table(const std::string& path) {
                                   time_in_ns ? "integer nanoseconds" : "seconds"));
     if (time_in_ns) t = ti;
     if (!table.t_ns.empty() && t <= table.t_ns.back())
-      throw UserError(fmt::format("{}:{}: time {} is not after the previous row's {}, expected "
-                                  "strictly increasing times",
-                                  path, line_no, format_seconds(t),
-                                  format_seconds(table.t_ns.back())));
+      throw UserError(
+          fmt::format("{}:{}: time {} is not after the previous row's {}, expected "
+                      "strictly increasing times",
+                      path, line_no, format_seconds(t), format_seconds(table.t_ns.back())));
     table.t_ns.push_back(t);
     for (std::size_t c = 0; c < cells.size(); ++c) {
       if (col_of_cell[c] < 0) continue;
@@ -127,8 +129,8 @@ std::vector<Section> compute_sections(const std::vector<TimeNs>& t_ns,
                                       const SectionOptions& options, const FrameTable* frames) {
   DRIFTLAB_DEMAND(t_ns.size() == T_W_C_gt.size() && t_ns.size() == T_W_C_est.size());
   if (!(options.section_length_m > 0))
-    throw UserError(fmt::format("section_length_m: got {}, expected a value > 0",
-                                options.section_length_m));
+    throw UserError(
+        fmt::format("section_length_m: got {}, expected a value > 0", options.section_length_m));
   const std::size_t n = t_ns.size();
   const SE3 T_C_F(R_optical_frd(), Vec3::Zero());  // camera FRD axes -> optical
   std::vector<SE3> G(n), E(n);
@@ -164,7 +166,7 @@ std::vector<Section> compute_sections(const std::vector<TimeNs>& t_ns,
     const SE3 dG = G[start].inverse() * G[end];
     const SE3 dE = E[start].inverse() * E[end];
     sec.err_m = dG.translation() - dE.translation();           // Eq. (10)
-    sec.err_p_m = sec.err_m.norm();                             // Eq. (12)
+    sec.err_p_m = sec.err_m.norm();                            // Eq. (12)
     const EulerZYX eg = euler_zyx_from_quat(dG.quaternion());  // Eq. (11)
     const EulerZYX ee = euler_zyx_from_quat(dE.quaternion());
     sec.err_rad.roll_rad = wrap_angle_rad(eg.roll_rad - ee.roll_rad);

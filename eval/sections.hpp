@@ -50,7 +50,7 @@ struct Section {
   std::size_t last = 0;   // index of the end pose
   TimeNs t_start_ns = 0;
   TimeNs t_end_ns = 0;
-  double length_m = 0;    // ground-truth path length of the section
+  double length_m = 0;        // ground-truth path length of the section
   Vec3 err_m = Vec3::Zero();  // Eq. (10): truth minus estimate, start-camera FRD axes [m]
   double err_p_m = 0;         // Eq. (12)
   EulerZYX err_rad;           // Eq. (11): truth minus estimate, wrapped [rad]

@@ -31,8 +31,8 @@ CameraStage::CameraStage(const Scenario& sc, sim::StereoRenderer* renderer, cons
   renderer_->set_right_camera(sim::true_T_left_right(sc.sensors.camera));
   if (sc.sensors.camera.lens_distortion.enabled) lens_.emplace(sc.sensors.camera);
   if (auto_exposure_.enabled)
-    exposure_ms_ = std::clamp(exposure_ms_, auto_exposure_.min_exposure_ms,
-                              auto_exposure_.max_exposure_ms);
+    exposure_ms_ =
+        std::clamp(exposure_ms_, auto_exposure_.min_exposure_ms, auto_exposure_.max_exposure_ms);
 }
 
 sim::StereoImages CameraStage::render_blurred(const FrameTruth& truth) {

@@ -33,9 +33,9 @@ namespace driftlab::pipeline {
 
 /// The true state of the camera's platform at a frame.
 struct FrameTruth {
-  double t_s = 0;                // true time of the frame (centre of the exposure)
-  SE3 T_W_B;                     // body pose
-  Vec6 twist_B = Vec6::Zero();   // [v_B; w_B]: body-frame velocity and angular rate
+  double t_s = 0;               // true time of the frame (centre of the exposure)
+  SE3 T_W_B;                    // body pose
+  Vec6 twist_B = Vec6::Zero();  // [v_B; w_B]: body-frame velocity and angular rate
 };
 
 class CameraStage {

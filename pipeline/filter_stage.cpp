@@ -85,8 +85,7 @@ FilterTrack::FilterTrack(FusionAlgorithm kind, const Scenario& sc, const SensorD
       s.pf = std::make_unique<fusion::NedParticleFilter>(sc.pipeline.ned_pf,
                                                          rng.stream("fusion.ned_pf"), init);
   } else if (kind == FusionAlgorithm::kEskf) {
-    if (sensors.imu.empty())
-      throw UserError(who + " needs the IMU (sensors.imu.enabled: true)");
+    if (sensors.imu.empty()) throw UserError(who + " needs the IMU (sensors.imu.enabled: true)");
     const SE3 T_B_I = sim::SensorMount::from_options(sc.sensors.imu.mount).T_B_S();
     const Mat3 R_B_M = sim::SensorMount::from_options(sc.sensors.compass.mount).R_B_S;
     const auto& a = sc.sensors.gps.antenna_frd_m;

@@ -18,8 +18,13 @@ std::string clock_text(double s) {
 
 Progress::Progress(std::FILE* out, std::string what, std::size_t total, bool tty,
                    double line_every_s)
-    : out_(out), what_(std::move(what)), total_(total), tty_(tty), every_s_(line_every_s),
-      start_(Clock::now()), last_(start_) {}
+    : out_(out),
+      what_(std::move(what)),
+      total_(total),
+      tty_(tty),
+      every_s_(line_every_s),
+      start_(Clock::now()),
+      last_(start_) {}
 
 std::string Progress::line(const std::string& what, std::size_t done, std::size_t total,
                            double elapsed_s, bool bar) {
@@ -28,10 +33,10 @@ std::string Progress::line(const std::string& what, std::size_t done, std::size_
   std::string s = what + "  ";
   if (bar) {
     constexpr int kWidth = 24;
-    const int filled =
-        total > 0 ? static_cast<int>(kWidth * static_cast<double>(std::min(done, total)) /
-                                     static_cast<double>(total))
-                  : kWidth;
+    const int filled = total > 0
+                           ? static_cast<int>(kWidth * static_cast<double>(std::min(done, total)) /
+                                              static_cast<double>(total))
+                           : kWidth;
     s += "[" + std::string(static_cast<std::size_t>(filled), '#') +
          std::string(static_cast<std::size_t>(kWidth - filled), ' ') + "]  ";
   }

@@ -20,7 +20,6 @@
 namespace driftlab::pipeline {
 namespace {
 
-
 void write_png(const std::filesystem::path& path, const sim::GrayImage& img) {
   const cv::Mat m(img.height, img.width, CV_8UC1, const_cast<std::uint8_t*>(img.pixels.data()));
   if (!cv::imwrite(path.string(), m))
@@ -36,9 +35,10 @@ void write_pfm(const std::filesystem::path& path, const sim::DepthImage& d) {
 }  // namespace
 
 std::string RenderSequenceSummary::brief() const {
-  return fmt::format("rendered {} stereo pairs ({} triangles) at {:.1f} pairs/s; scene built in "
-                     "{:.2f} s; {}",
-                     frames, triangles, pairs_per_s, scene_build_s, context);
+  return fmt::format(
+      "rendered {} stereo pairs ({} triangles) at {:.1f} pairs/s; scene built in "
+      "{:.2f} s; {}",
+      frames, triangles, pairs_per_s, scene_build_s, context);
 }
 
 StereoRig rig_of(const sim::CameraOptions& c) {
@@ -107,14 +107,16 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
     const auto t0 = SteadyClock::now();
     sim::StereoImages img = camera.capture(truth[k]);
     if (depth)  // ground truth: the ideal pinhole depth at the centre of the exposure
-      img.depth_left = renderer.render(poses[k].T_W_C, ns_to_seconds(poses[k].t_ns), true).depth_left;
+      img.depth_left =
+          renderer.render(poses[k].T_W_C, ns_to_seconds(poses[k].t_ns), true).depth_left;
     render_s += seconds_since(t0);
     ++delivered;
     const std::string name = fmt::format("{:06d}", k);
     write_png(dir.path() / "left" / (name + ".png"), img.left);
     write_png(dir.path() / "right" / (name + ".png"), img.right);
     if (depth) write_pfm(dir.path() / "depth" / (name + ".pfm"), img.depth_left);
-    times.write(fmt::format("{},{}\n", k, k < stamps.size() ? stamps[k].t_stamp_ns : poses[k].t_ns));
+    times.write(
+        fmt::format("{},{}\n", k, k < stamps.size() ? stamps[k].t_stamp_ns : poses[k].t_ns));
   }
   times.commit();
   write_tum(dir.path() / "groundtruth.tum", poses);

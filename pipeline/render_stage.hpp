@@ -11,8 +11,8 @@
 namespace driftlab::pipeline {
 
 struct RenderSequenceOptions {
-  int max_frames = 0;          // 0: every frame of the mission (or pipeline.max_frames)
-  bool depth = false;          // also write depth/NNNNNN.pfm (metres, float)
+  int max_frames = 0;  // 0: every frame of the mission (or pipeline.max_frames)
+  bool depth = false;  // also write depth/NNNNNN.pfm (metres, float)
   bool replace_existing = false;
 };
 
@@ -20,9 +20,9 @@ struct RenderSequenceSummary {
   std::size_t frames = 0;
   std::size_t triangles = 0;
   double scene_build_s = 0;
-  double render_s = 0;           // rendering and read-back only
+  double render_s = 0;  // rendering and read-back only
   double pairs_per_s = 0;
-  std::string context;           // GL version and renderer
+  std::string context;  // GL version and renderer
   std::string brief() const;
 };
 
@@ -32,7 +32,8 @@ StereoRig rig_of(const sim::CameraOptions& camera);
 /// Simulates the motion, builds the scene around the track, renders every
 /// frame into out_dir/{left,right}/NNNNNN.png (+ depth/NNNNNN.pfm) and
 /// out_dir/times.csv (frame, t_ns); the folder appears only when complete.
-RenderSequenceSummary render_sequence(const Scenario& scenario, const std::filesystem::path& out_dir,
+RenderSequenceSummary render_sequence(const Scenario& scenario,
+                                      const std::filesystem::path& out_dir,
                                       const RenderSequenceOptions& options);
 
 }  // namespace driftlab::pipeline

@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <iterator>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "core/atomic_file.hpp"
-#include "core/rotation.hpp"
 #include "core/rng.hpp"
+#include "core/rotation.hpp"
 #include "core/stopwatch.hpp"
 #include "core/trajectory_io.hpp"
 #include "core/yaml_io.hpp"
@@ -20,8 +20,8 @@
 #include "pipeline/filter_stage.hpp"
 #include "pipeline/progress.hpp"
 #include "pipeline/render_stage.hpp"
-#include "report/run_report.hpp"
 #include "pipeline/sensor_stage.hpp"
+#include "report/run_report.hpp"
 #include "scenes/build_scene.hpp"
 #include "sim/render/renderer.hpp"
 #include "sim/waves/wave_field.hpp"
@@ -148,7 +148,7 @@ struct Track {
   std::unique_ptr<vo::StereoOdometry> vo;
   std::unique_ptr<fusion::ConstantAccelerationSmoother> smoother;  // set for NAME_ca streams
   std::unique_ptr<FilterTrack> filter;  // NAME_ned_kf, NAME_ned_pf, NAME_eskf streams
-  std::size_t source = 0;  // for a smoothed stream: the VO track it follows
+  std::size_t source = 0;               // for a smoothed stream: the VO track it follows
   Trajectory estimate;
   std::vector<vo::VoResult> results;
   double vo_ms = 0;
@@ -222,8 +222,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   for (VoAlgorithm a : sc.pipeline.vo) {
     auto v = make_vo(a, rig, sc.pipeline, rng);
     if (!v) {
-      warnings.push_back(fmt::format("pipeline.vo: '{}' is not in this build yet; skipped",
-                                     yaml::enum_name(a)));
+      warnings.push_back(
+          fmt::format("pipeline.vo: '{}' is not in this build yet; skipped", yaml::enum_name(a)));
       continue;
     }
     Track t;
@@ -275,8 +275,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
     const Stopwatch t_render;
     const double exposure_ms = camera.exposure_ms();  // this frame's (auto exposure)
     const sim::StereoImages img = camera.capture(frame_truth[k]);
-    const double render_ms =
-        t_render.ms();
+    const double render_ms = t_render.ms();
     render_s += render_ms / 1000;
     vo::StereoFrame frame;
     frame.t_ns = t;
@@ -289,8 +288,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
                                   render_ms, yaml::format_double(exposure_ms));
     for (std::size_t i = 0; i < tracks.size(); ++i) {
       Track& tr = tracks[i];
-      const vo::VoResult r =
-          tr.vo ? tr.vo->process(frame) : tracks[tr.source].results.back();
+      const vo::VoResult r = tr.vo ? tr.vo->process(frame) : tracks[tr.source].results.back();
       if (k == sample_frame && tr.vo && r.valid) {
         if (const auto* sparse = dynamic_cast<const vo::SparseStereoOdometry*>(tr.vo.get()))
           cv::imwrite((dir / "plots" / (tr.name + "_matches.png")).string(),
@@ -305,7 +303,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
       }
       if (k == first) {
         if (tr.smoother) tr.smoother->update(t, r);  // starts the clock
-        if (tr.filter) tr.filter->step(t, r);         // starts from the anchor
+        if (tr.filter) tr.filter->step(t, r);        // starts from the anchor
         continue;
       }
       if (tr.filter) {  // absolute poses, not increments
@@ -350,7 +348,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
       ft.columns[1].push_back(rad2deg(platform[k].pitch_rad));
       ft.columns[2].push_back(rad2deg(platform[k].roll_rad));
       const vo::VoResult& r = src.results[k];
-      // Covariate f: inlier features (sparse, river paper Table 4), pixels with valid depth (dense).
+      // Covariate f: inlier features (sparse, river paper Table 4), pixels with valid depth
+      // (dense).
       const double f = tr.name.rfind("dense", 0) == 0 ? r.valid_depth_pixels : r.inliers;
       ft.columns[3].push_back(r.valid ? f : std::numeric_limits<double>::quiet_NaN());
       ft.columns[4].push_back(r.valid ? r.mean_inlier_depth_m
@@ -385,7 +384,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   if (!plots.empty()) report += "## Plots\n\n";
   for (const auto& p : plots) report += fmt::format("![{}]({})\n\n", p.title, p.file);
   write_file_atomic(dir / "report.md", report);
-  write_file_atomic(dir / "report.html", report::report_html("driftlab run: " + sc.name, tables, plots));
+  write_file_atomic(dir / "report.html",
+                    report::report_html("driftlab run: " + sc.name, tables, plots));
   (*metrics)["timing"]["render_s"] = render_s;
   (*metrics)["timing"]["render_pairs_per_s"] =
       render_s > 0 ? static_cast<double>(camera_gt.size() - dropped) / render_s : 0.0;
@@ -415,7 +415,7 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
   const SE3 T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
   Trajectory camera_gt;
   std::vector<FrameTruth> frame_truth;  // body pose and twist at each frame (the camera stage)
-  std::vector<EulerZYX> platform;  // body attitude at each frame (the IMU's, for covariate h)
+  std::vector<EulerZYX> platform;       // body attitude at each frame (the IMU's, for covariate h)
   AtomicFile body(dir.path() / "body_groundtruth.csv");
   body.write(body_csv_header());
   const auto t_physics = SteadyClock::now();
@@ -464,9 +464,11 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
                        {"distance_m", summary.motion.distance_m},
                        {"mean_speed_m_s", summary.motion.mean_speed_mps},
                        {"physics_steps", summary.motion.steps}};
-  const char* vision = run_vo ? "done" : (options.only_motion ? "skipped (--only-motion)" : "skipped (no VO in pipeline.vo)");
+  const char* vision =
+      run_vo ? "done"
+             : (options.only_motion ? "skipped (--only-motion)" : "skipped (no VO in pipeline.vo)");
   metrics["stages"] = {{"scenario", "done"}, {"physics", "done"}, {"sensors", "done"},
-                       {"render", vision},     {"vo", vision},      {"fusion", vision},
+                       {"render", vision},   {"vo", vision},      {"fusion", vision},
                        {"eval", vision}};
   metrics["timing"]["physics_s"] = summary.physics_s;
   metrics["timing"]["total_s"] = summary.total_s;

@@ -18,7 +18,7 @@ namespace driftlab::pipeline {
 
 struct RunOptions {
   bool replace_existing = false;
-  bool only_motion = false;  // stop after the physics stage
+  bool only_motion = false;       // stop after the physics stage
   std::FILE* progress = nullptr;  // progress of the frame loop (e.g. stderr); null: none
   bool progress_tty = false;      // redraw a bar in place (a terminal) instead of plain lines
 };

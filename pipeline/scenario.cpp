@@ -38,9 +38,10 @@ std::vector<std::array<double, 2>> read_waypoints_csv(const std::filesystem::pat
                                                       const std::string& referenced_at) {
   std::ifstream in(path);
   if (!in)
-    throw UserError(fmt::format("{}: mission.waypoints_file: got '{}', expected an existing "
-                                "readable CSV file (north_m,east_m per line)",
-                                referenced_at, path.string()));
+    throw UserError(
+        fmt::format("{}: mission.waypoints_file: got '{}', expected an existing "
+                    "readable CSV file (north_m,east_m per line)",
+                    referenced_at, path.string()));
   std::vector<std::array<double, 2>> out;
   std::string line;
   int line_no = 0;
@@ -52,8 +53,8 @@ std::vector<std::array<double, 2>> read_waypoints_csv(const std::filesystem::pat
     if (first == std::string::npos || line[first] == '#') continue;
     const std::vector<std::string> cells = split_csv_line(line, CsvTrim::kSpaces);
     double n = 0, e = 0;
-    const bool numbers = cells.size() == 2 && yaml::parse_double(cells[0], &n) &&
-                         yaml::parse_double(cells[1], &e);
+    const bool numbers =
+        cells.size() == 2 && yaml::parse_double(cells[0], &n) && yaml::parse_double(cells[1], &e);
     const bool first_content_line = !seen_content;
     seen_content = true;
     if (!numbers && first_content_line && cells.size() == 2) continue;  // header
@@ -74,8 +75,7 @@ void resolve_files(Scenario* s, const YAML::Node& root, const std::string& label
     std::filesystem::path p = s->mission.waypoints_file;
     if (p.is_relative()) p = base_dir / p;
     auto points = read_waypoints_csv(p, where_key(root, label, {"mission", "waypoints_file"}));
-    s->mission.waypoints_ne_m.insert(s->mission.waypoints_ne_m.end(), points.begin(),
-                                     points.end());
+    s->mission.waypoints_ne_m.insert(s->mission.waypoints_ne_m.end(), points.begin(), points.end());
     // The resolved scenario carries the points themselves, so it is self-contained.
     s->mission.waypoints_file.clear();
   }
@@ -99,12 +99,14 @@ void validate_scenario(const Scenario& s, const std::string& label) {
   yaml::ErrorList errors;
   if (!problems.empty()) errors.add(problems);
   if (s.mission.type == sim::MissionType::kWaypoints && s.mission.waypoints_ne_m.size() < 2)
-    errors.add(fmt::format("mission.waypoints_ne_m: got {} waypoints, expected at least 2 for "
-                           "mission type 'waypoints'",
-                           s.mission.waypoints_ne_m.size()));
+    errors.add(
+        fmt::format("mission.waypoints_ne_m: got {} waypoints, expected at least 2 for "
+                    "mission type 'waypoints'",
+                    s.mission.waypoints_ne_m.size()));
   if (s.pipeline.vo.empty() && !s.pipeline.fusion.empty())
-    errors.add("pipeline.fusion: got filters but no VO to feed them, expected pipeline.vo to "
-               "name at least one VO algorithm");
+    errors.add(
+        "pipeline.fusion: got filters but no VO to feed them, expected pipeline.vo to "
+        "name at least one VO algorithm");
   // The camera clock's stamps must stay within the association tolerance of
   // the true frame times, or no estimate would be paired with ground truth.
   const auto& clock = s.sensors.camera.clock;

@@ -16,7 +16,8 @@ struct Gnuplot {
 
 struct GnuplotLookup {
   std::optional<Gnuplot> gnuplot;
-  std::string warning;  ///< why there is none, e.g. "gnuplot not found on PATH (install gnuplot-nox)"
+  std::string
+      warning;  ///< why there is none, e.g. "gnuplot not found on PATH (install gnuplot-nox)"
 };
 
 /// gnuplot from PATH, or `executable` when given; probes for the pngcairo terminal.

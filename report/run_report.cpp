@@ -1,6 +1,5 @@
 #include "report/run_report.hpp"
 
-
 #include <array>
 #include <cmath>
 #include <map>
@@ -9,11 +8,11 @@
 #include <fmt/format.h>
 
 #include "core/atomic_file.hpp"
+#include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/rotation.hpp"
 #include "core/time.hpp"
 #include "core/yaml_io.hpp"
-#include "core/csv.hpp"
 #include "report/gnuplot.hpp"
 
 namespace driftlab::report {
@@ -64,18 +63,26 @@ std::string html_escape(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
 }
 
 }  // namespace
-
 
 PlotSet make_plots(const std::filesystem::path& dir, const Trajectory& gt,
                    const std::vector<NamedTrajectory>& estimates, const std::string& sections_csv) {
@@ -123,39 +130,51 @@ PlotSet make_plots(const std::filesystem::path& dir, const Trajectory& gt,
   std::vector<PlotFile> made;
   std::string gp =
       "# Made by driftlab run; re-run with: cd plots && gnuplot plots.gp\n"
-      "set terminal " + terminal + " size 900,640 font ',10' noenhanced\n"
+      "set terminal " +
+      terminal +
+      " size 900,640 font ',10' noenhanced\n"
       "set grid\nset key outside right top\n";
   auto curves = [&](const std::string& using_gt, const std::string& using_est, bool with_gt) {
     std::string s;
-    if (with_gt) s += "'data/groundtruth.dat' using " + using_gt + " with lines lw 2 lc 'black' title 'ground truth'";
+    if (with_gt)
+      s += "'data/groundtruth.dat' using " + using_gt +
+           " with lines lw 2 lc 'black' title 'ground truth'";
     for (const auto& e : estimates) {
       if (!s.empty()) s += ", ";
       s += q("data/" + e.name + ".dat") + " using " + using_est + " with lines title " + q(e.name);
     }
     return s;
   };
-  gp += "set output 'top_view.png'\nset title 'Top view (river paper Fig. 6)'\n"
-        "set xlabel 'east [m]'\nset ylabel 'north [m]'\nset size ratio -1\n"
-        "plot " + curves("3:2", "3:2", true) + "\nset size noratio\n";
-  made.push_back({"Top view of the ground truth and every estimate (Fig. 6)", "plots/top_view.png"});
-  gp += "set output 'position_error.png'\nset title '3D position error'\n"
-        "set xlabel 'time [s]'\nset ylabel 'error [m]'\nplot " + curves("1:8", "1:8", false) + "\n";
+  gp +=
+      "set output 'top_view.png'\nset title 'Top view (river paper Fig. 6)'\n"
+      "set xlabel 'east [m]'\nset ylabel 'north [m]'\nset size ratio -1\n"
+      "plot " +
+      curves("3:2", "3:2", true) + "\nset size noratio\n";
+  made.push_back(
+      {"Top view of the ground truth and every estimate (Fig. 6)", "plots/top_view.png"});
+  gp +=
+      "set output 'position_error.png'\nset title '3D position error'\n"
+      "set xlabel 'time [s]'\nset ylabel 'error [m]'\nplot " +
+      curves("1:8", "1:8", false) + "\n";
   made.push_back({"3D position error over time", "plots/position_error.png"});
-  gp += "set output 'euler.png'\nset multiplot layout 3,1 title 'Camera attitude, FRD axes (Fig. 7)'\n"
-        "set xlabel ''\n";
+  gp +=
+      "set output 'euler.png'\nset multiplot layout 3,1 title 'Camera attitude, FRD axes (Fig. "
+      "7)'\n"
+      "set xlabel ''\n";
   const char* angles[] = {"yaw", "pitch", "roll"};
   for (int a = 0; a < 3; ++a) {
     const std::string col = std::to_string(5 + a);
-    gp += fmt::format("set title ''\nset ylabel '{} [deg]'\n{}plot {}\n", angles[a],
-                      a == 2 ? "set xlabel 'time [s]'\n" : "",
-                      curves("1:" + col, "1:" + col, true));
+    gp +=
+        fmt::format("set title ''\nset ylabel '{} [deg]'\n{}plot {}\n", angles[a],
+                    a == 2 ? "set xlabel 'time [s]'\n" : "", curves("1:" + col, "1:" + col, true));
   }
   gp += "unset multiplot\n";
   made.push_back({"Euler angles of the estimates and the truth (Fig. 7)", "plots/euler.png"});
   if (!section_order.empty()) {
-    gp += "set output 'section_errors.png'\nset title 'Section position error e''_p (Fig. 5)'\n"
-          "set xlabel 'e''_p [m/m]'\nset ylabel 'sections'\nset style fill transparent solid 0.4\n"
-          "bin(x) = 0.02 * floor(x / 0.02) + 0.01\nplot ";
+    gp +=
+        "set output 'section_errors.png'\nset title 'Section position error e''_p (Fig. 5)'\n"
+        "set xlabel 'e''_p [m/m]'\nset ylabel 'sections'\nset style fill transparent solid 0.4\n"
+        "bin(x) = 0.02 * floor(x / 0.02) + 0.01\nplot ";
     for (std::size_t i = 0; i < section_order.size(); ++i)
       gp += (i ? ", " : "") + q("data/sections_" + section_order[i] + ".dat") +
             " using (bin($1)):(1) smooth frequency with boxes title " + q(section_order[i]);
@@ -241,7 +260,8 @@ std::string report_html(const std::string& title, const std::string& markdown,
       in_table = false;
     }
     if (table_line) {
-      if (line.find("---") != std::string::npos && line.find_first_not_of("|-: ") == std::string::npos)
+      if (line.find("---") != std::string::npos &&
+          line.find_first_not_of("|-: ") == std::string::npos)
         continue;  // the separator row
       const char* tag = header_row ? "th" : "td";
       h += "<tr>";

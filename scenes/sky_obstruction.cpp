@@ -11,8 +11,7 @@ namespace driftlab::scenes {
 MeshSkyObstruction::MeshSkyObstruction(const sim::SceneGeometry& scene, double cell_m)
     : cell_(cell_m) {
   if (!(cell_m > 0.0 && std::isfinite(cell_m)))
-    throw UserError("MeshSkyObstruction: cell_m: got " + std::to_string(cell_m) +
-                    ", expected > 0");
+    throw UserError("MeshSkyObstruction: cell_m: got " + std::to_string(cell_m) + ", expected > 0");
   double n_min = std::numeric_limits<double>::infinity(), n_max = -n_min;
   double e_min = n_min, e_max = -n_min;
   top_z_ = std::numeric_limits<double>::infinity();
@@ -44,8 +43,10 @@ MeshSkyObstruction::MeshSkyObstruction(const sim::SceneGeometry& scene, double c
   const auto cells = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
   cell_begin_.assign(cells + 1, 0);
   auto range = [this](const sim::Triangle& t, int* i0, int* i1, int* j0, int* j1) {
-    const double a = std::min({t.a.x(), t.b.x(), t.c.x()}), b = std::max({t.a.x(), t.b.x(), t.c.x()});
-    const double c = std::min({t.a.y(), t.b.y(), t.c.y()}), d = std::max({t.a.y(), t.b.y(), t.c.y()});
+    const double a = std::min({t.a.x(), t.b.x(), t.c.x()}),
+                 b = std::max({t.a.x(), t.b.x(), t.c.x()});
+    const double c = std::min({t.a.y(), t.b.y(), t.c.y()}),
+                 d = std::max({t.a.y(), t.b.y(), t.c.y()});
     *i0 = std::clamp(static_cast<int>((a - n0_) / cell_), 0, nx_ - 1);
     *i1 = std::clamp(static_cast<int>((b - n0_) / cell_), 0, nx_ - 1);
     *j0 = std::clamp(static_cast<int>((c - e0_) / cell_), 0, ny_ - 1);
@@ -98,10 +99,11 @@ bool MeshSkyObstruction::blocked(const Vec3& from_W, const Vec3& direction_W) co
   while (t <= t_end) {
     const bool inside = i >= 0 && i < nx_ && j >= 0 && j < ny_;
     if (inside) {
-      const auto c = static_cast<std::size_t>(i) * static_cast<std::size_t>(ny_) +
-                     static_cast<std::size_t>(j);
+      const auto c =
+          static_cast<std::size_t>(i) * static_cast<std::size_t>(ny_) + static_cast<std::size_t>(j);
       for (std::uint32_t k = cell_begin_[c]; k < cell_begin_[c + 1]; ++k) {
-        const auto hit = sim::ray_triangle_distance(from_W, direction_W, triangles_[cell_items_[k]]);
+        const auto hit =
+            sim::ray_triangle_distance(from_W, direction_W, triangles_[cell_items_[k]]);
         if (hit && *hit > 1e-6) return true;
       }
     } else if ((i < 0 && step_i < 0) || (i >= nx_ && step_i > 0) || (j < 0 && step_j < 0) ||
@@ -130,7 +132,8 @@ std::vector<sim::MagneticAnomalyOptions> steel_anomalies(const sim::SceneGeometr
   std::vector<sim::MagneticAnomalyOptions> out;
   for (const sim::Mesh& m : scene.meshes) {
     const bool steel = std::any_of(suffixes.begin(), suffixes.end(), [&m](const std::string& s) {
-      return m.name.size() >= s.size() && m.name.compare(m.name.size() - s.size(), s.size(), s) == 0;
+      return m.name.size() >= s.size() &&
+             m.name.compare(m.name.size() - s.size(), s.size(), s) == 0;
     });
     if (!steel || m.vertices.empty()) continue;
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;

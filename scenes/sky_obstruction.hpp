@@ -29,9 +29,9 @@ class MeshSkyObstruction final : public sim::SkyObstruction {
  private:
   std::vector<sim::Triangle> triangles_;
   double cell_ = 2.0;
-  double n0_ = 0.0, e0_ = 0.0;  // grid origin (north, east) [m]
-  int nx_ = 0, ny_ = 0;         // cells along north, east
-  double top_z_ = 0.0;          // smallest z (highest point) of the scene, NED [m]
+  double n0_ = 0.0, e0_ = 0.0;             // grid origin (north, east) [m]
+  int nx_ = 0, ny_ = 0;                    // cells along north, east
+  double top_z_ = 0.0;                     // smallest z (highest point) of the scene, NED [m]
   std::vector<std::uint32_t> cell_begin_;  // CSR: triangles of cell (i, j) at i * ny_ + j
   std::vector<std::uint32_t> cell_items_;
 };

@@ -14,9 +14,9 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/process.hpp"
 #include "core/rng.hpp"
 #include "core/yaml_io.hpp"
-#include "core/process.hpp"
 #include "pipeline/scenario.hpp"
 
 #ifndef DRIFTLAB_VERSION
@@ -25,10 +25,10 @@
 
 namespace driftlab::study {
 
-using pipeline::Scenario;
 using pipeline::load_scenario;
 using pipeline::parse_scenario;
 using pipeline::resolved_yaml;
+using pipeline::Scenario;
 namespace fs = std::filesystem;
 
 namespace {

@@ -16,16 +16,16 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/process.hpp"
 #include "core/yaml_io.hpp"
 #include "eval/regression.hpp"
 #include "eval/stats.hpp"
-#include "core/process.hpp"
 #include "pipeline/scenario.hpp"
 
 namespace driftlab::study {
 
-using pipeline::Scenario;
 using pipeline::parse_scenario;
+using pipeline::Scenario;
 namespace fs = std::filesystem;
 
 const std::vector<RunMetric>& run_metrics() {
@@ -300,8 +300,8 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
   if (default_covariates) {
     std::vector<std::string> base_covariates{"v", "h", "f", "d"};
     try {
-      const Scenario base =
-          parse_scenario(read_text_file(m.scenario_file(), "scenario file"), m.scenario_file().string(), m.base_dir());
+      const Scenario base = parse_scenario(read_text_file(m.scenario_file(), "scenario file"),
+                                           m.scenario_file().string(), m.base_dir());
       base_covariates = base.eval.regression_covariates;
     } catch (const UserError&) {
       // The plan checked scenario.yaml; if it was edited since, the runs say what is there.

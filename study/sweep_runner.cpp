@@ -17,8 +17,8 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
-#include "core/yaml_io.hpp"
 #include "core/process.hpp"
+#include "core/yaml_io.hpp"
 #include "pipeline/scenario.hpp"
 
 #ifndef DRIFTLAB_VERSION
@@ -27,10 +27,10 @@
 
 namespace driftlab::study {
 
-using pipeline::Scenario;
 using pipeline::parse_scenario;
-using pipeline::RunOptions;
 using pipeline::run_scenario;
+using pipeline::RunOptions;
+using pipeline::Scenario;
 namespace fs = std::filesystem;
 
 namespace {
@@ -144,8 +144,8 @@ JobRunResult run_manifest_job(const SweepManifest& m, const std::string& id,
           fmt::format("{}: no such file, expected the base scenario that `driftlab "
                       "sweep plan` wrote beside the manifest",
                       scenario_file.string()));
-    const Scenario sc = parse_scenario(read_text_file(scenario_file, "scenario file"), scenario_file.string(),
-                                       m.base_dir(), job.overrides);
+    const Scenario sc = parse_scenario(read_text_file(scenario_file, "scenario file"),
+                                       scenario_file.string(), m.base_dir(), job.overrides);
     const std::string hash = fnv1a64_hex(yaml::to_yaml(sc, false));
     if (hash != job.hash)
       throw UserError(fmt::format(

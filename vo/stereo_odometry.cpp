@@ -31,10 +31,10 @@ void check_image(const cv::Mat& image, const PinholeCamera& camera, const char* 
                  const char* which) {
   if (image.empty() || image.type() != CV_8UC1 || image.cols != camera.width ||
       image.rows != camera.height) {
-    throw UserError(std::string(who) + ": " + which + " image: got " +
-                    std::to_string(image.cols) + "x" + std::to_string(image.rows) + " of type " +
-                    std::to_string(image.type()) + ", expected " + std::to_string(camera.width) +
-                    "x" + std::to_string(camera.height) + " CV_8UC1");
+    throw UserError(std::string(who) + ": " + which + " image: got " + std::to_string(image.cols) +
+                    "x" + std::to_string(image.rows) + " of type " + std::to_string(image.type()) +
+                    ", expected " + std::to_string(camera.width) + "x" +
+                    std::to_string(camera.height) + " CV_8UC1");
   }
 }
 

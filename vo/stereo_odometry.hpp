@@ -43,8 +43,9 @@ struct VoResult {
                        ///< left camera, OpenCV optical frame (x right, y down, z forward)
   int matches = 0;     ///< correspondences handed to the estimator
   int inliers = 0;     ///< of those, consistent with the estimated motion
-  double mean_inlier_depth_m = 0.0;  ///< mean optical-axis depth of the inliers, current frame [m]
-                                     ///< (dense: of the pixels used; covariate d of the river paper)
+  double mean_inlier_depth_m =
+      0.0;                     ///< mean optical-axis depth of the inliers, current frame [m]
+                               ///< (dense: of the pixels used; covariate d of the river paper)
   int valid_depth_pixels = 0;  ///< dense VO: pixels with a valid depth in the depth map the motion
                                ///< was estimated from (covariate f of the river paper); others: 0
   VoStageTimes times;

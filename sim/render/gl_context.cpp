@@ -72,7 +72,8 @@ class EglContext : public GlContext {
       auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
           eglGetProcAddress("eglGetPlatformDisplayEXT"));
       if (get_platform_display)
-        display_ = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+        display_ =
+            get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
       if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor))
         throw UserError(fmt::format(
             "render.backend egl: no EGL display could be initialised (EGL error 0x{:x}); use "

@@ -7,11 +7,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <numbers>
-#include <map>
-#include <tuple>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
+#include <map>
+#include <numbers>
+#include <tuple>
 
 #include "core/error.hpp"
 
@@ -278,9 +278,7 @@ void set_mat4(GLuint p, const char* name, const Eigen::Matrix4f& m) {
   glUniformMatrix4fv(loc(p, name), 1, GL_FALSE, m.data());  // Eigen is column-major
 }
 
-Eigen::Matrix4f to_view(const SE3& T_W_C) {
-  return T_W_C.inverse().matrix().cast<float>();
-}
+Eigen::Matrix4f to_view(const SE3& T_W_C) { return T_W_C.inverse().matrix().cast<float>(); }
 
 struct GpuMesh {
   GLuint vao = 0, vbo = 0, ebo = 0;
@@ -302,7 +300,8 @@ std::array<Eigen::Vector4f, 6> frustum_planes(const Eigen::Matrix4f& vp) {
   return p;
 }
 
-bool sphere_visible(const std::array<Eigen::Vector4f, 6>& planes, const Eigen::Vector3f& c, float r) {
+bool sphere_visible(const std::array<Eigen::Vector4f, 6>& planes, const Eigen::Vector3f& c,
+                    float r) {
   for (const auto& q : planes)
     if (q.head<3>().dot(c) + q.w() < -r) return false;
   return true;
@@ -341,7 +340,7 @@ struct StereoRenderer::Impl {
   int water_segments = 0;
   float water_radius_m = 0;
   float wave_amplitude_sum_m = 0;
-  std::vector<float> wave_a;      // 4 per component
+  std::vector<float> wave_a;  // 4 per component
   std::vector<float> wave_phase;
   // Framebuffers.
   // Framebuffers, one set per eye: both eyes are drawn before either is read
@@ -451,8 +450,8 @@ void StereoRenderer::Impl::build_water_grid() {
   glBindVertexArray(0);
 }
 
-void StereoRenderer::Impl::color_target_(GLuint* fbo, GLuint* tex, unsigned format, GLuint* depth_rb,
-                                         int W, int H) {
+void StereoRenderer::Impl::color_target_(GLuint* fbo, GLuint* tex, unsigned format,
+                                         GLuint* depth_rb, int W, int H) {
   glGenFramebuffers(1, fbo);
   glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
   glGenTextures(1, tex);
@@ -512,7 +511,8 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     glDeleteBuffers(1, &g.ebo);
   }
   m.meshes.clear();
-  if (!m.textures.empty()) glDeleteTextures(static_cast<GLsizei>(m.textures.size()), m.textures.data());
+  if (!m.textures.empty())
+    glDeleteTextures(static_cast<GLsizei>(m.textures.size()), m.textures.data());
   m.textures.clear();
   for (const Texture& t : scene.textures) {
     if (t.width <= 0 || t.height <= 0 ||
@@ -657,7 +657,8 @@ void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::
     const GpuMesh& g = meshes[index];
     const bool has_tex = g.material.texture >= 0;
     glUniform1i(loc(scene_prog, "u_has_tex"), has_tex ? 1 : 0);
-    if (has_tex) glBindTexture(GL_TEXTURE_2D, textures[static_cast<std::size_t>(g.material.texture)]);
+    if (has_tex)
+      glBindTexture(GL_TEXTURE_2D, textures[static_cast<std::size_t>(g.material.texture)]);
     glUniform1f(loc(scene_prog, "u_albedo"), g.material.albedo);
     glUniform1f(loc(scene_prog, "u_specular"), g.material.specular);
     glBindVertexArray(g.vao);

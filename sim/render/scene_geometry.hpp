@@ -29,9 +29,9 @@ struct Texture {
 
 /// How a mesh reflects light.
 struct Material {
-  int texture = -1;          // index into SceneGeometry::textures, -1 = none (white)
-  float albedo = 0.6f;       // multiplies the texture [0, 1]
-  float specular = 0.0f;     // strength of a sun glint on this surface [0, 1]
+  int texture = -1;       // index into SceneGeometry::textures, -1 = none (white)
+  float albedo = 0.6f;    // multiplies the texture [0, 1]
+  float specular = 0.0f;  // strength of a sun glint on this surface [0, 1]
 };
 
 struct Mesh {
@@ -43,22 +43,22 @@ struct Mesh {
 
 /// Light and sky.
 struct Lighting {
-  bool sun = false;                                   // false: overcast
+  bool sun = false;                                    // false: overcast
   Eigen::Vector3f sun_direction_W{0.3f, 0.2f, -0.9f};  // towards the sun (NED, z up is negative)
-  float ambient = 0.55f;        // overcast sky light [0, 1]
-  float diffuse = 0.45f;        // directional part
-  float sky_brightness = 0.85f; // sky gray level at the horizon [0, 1]
-  float fog_distance_m = 400.f; // distance at which fog reaches 63% [m]
+  float ambient = 0.55f;                               // overcast sky light [0, 1]
+  float diffuse = 0.45f;                               // directional part
+  float sky_brightness = 0.85f;                        // sky gray level at the horizon [0, 1]
+  float fog_distance_m = 400.f;                        // distance at which fog reaches 63% [m]
 };
 
 /// The water surface: a plane at still-water level (z = 0) displaced by the
 /// wave field, with reflection and a body colour.
 struct WaterAppearance {
   bool enabled = true;
-  float extent_m = 300.f;       // half-size of the water grid around the camera [m]
-  float body_gray = 0.18f;      // colour of light coming up from the water body [0, 1]
-  float turbidity = 0.5f;       // 0 clear (dark) .. 1 murky (brighter, less reflective)
-  float reflectivity = 1.0f;    // scales the Fresnel reflectance
+  float extent_m = 300.f;     // half-size of the water grid around the camera [m]
+  float body_gray = 0.18f;    // colour of light coming up from the water body [0, 1]
+  float turbidity = 0.5f;     // 0 clear (dark) .. 1 murky (brighter, less reflective)
+  float reflectivity = 1.0f;  // scales the Fresnel reflectance
 };
 
 struct SceneGeometry {

@@ -1,7 +1,7 @@
 #include "sim/sensors/camera_effects.hpp"
 
-#include <boost/math/distributions/normal.hpp>
 #include <fmt/format.h>
+#include <boost/math/distributions/normal.hpp>
 
 #include <algorithm>
 #include <array>
@@ -52,7 +52,8 @@ PhotometricModel::PhotometricModel(const CameraOptions& camera)
                        static_cast<std::size_t>(camera.height_px));
     std::size_t i = 0;
     for (int y = 0; y < camera.height_px; ++y)
-      for (int x = 0; x < camera.width_px; ++x) vignetting_[i++] = static_cast<float>(vignetting(x, y));
+      for (int x = 0; x < camera.width_px; ++x)
+        vignetting_[i++] = static_cast<float>(vignetting(x, y));
   }
 }
 
@@ -80,8 +81,8 @@ double next_auto_exposure_ms(const AutoExposureOptions& o, double exposure_ms,
   // the right way and gets there over frames.
   const double mean = std::max(image_mean_dn, 0.5);
   const double wanted = exposure_ms * o.target_mean_dn / mean;
-  const double next = std::exp(std::log(exposure_ms) +
-                               o.response * (std::log(wanted) - std::log(exposure_ms)));
+  const double next =
+      std::exp(std::log(exposure_ms) + o.response * (std::log(wanted) - std::log(exposure_ms)));
   return std::clamp(next, o.min_exposure_ms, o.max_exposure_ms);
 }
 

@@ -7,8 +7,7 @@
 
 namespace driftlab::sim {
 
-SensorClock::SensorClock(const ClockOptions& options, const RngStreams& rng,
-                         std::string_view name)
+SensorClock::SensorClock(const ClockOptions& options, const RngStreams& rng, std::string_view name)
     : options_(options),
       jitter_(rng.stream(std::string(name) + ".clock.jitter")),
       drop_(rng.stream(std::string(name) + ".clock.drop")) {
@@ -19,8 +18,7 @@ SampleTime SensorClock::stamp(TimeNs t_true_ns) {
   // Truncated at 3 sigma so that the ordering rule of ClockOptions (6 sigma
   // below one period) guarantees increasing stamps; clamping rather than
   // redrawing keeps exactly one draw per sample.
-  const double jitter_s =
-      options_.jitter_ms * 1e-3 * std::clamp(jitter_.normal(), -3.0, 3.0);
+  const double jitter_s = options_.jitter_ms * 1e-3 * std::clamp(jitter_.normal(), -3.0, 3.0);
   const bool dropped = drop_.uniform() < options_.drop_probability;
   SampleTime s;
   s.t_true_ns = t_true_ns;
@@ -41,8 +39,8 @@ std::vector<SampleTime> stamp_times(const std::vector<TimeNs>& true_times_ns,
 
 SensorMount SensorMount::from_options(const MountOptions& mount) {
   SensorMount m;
-  m.R_B_S = quat_from_euler_zyx({deg2rad(mount.rpy_deg[0]), deg2rad(mount.rpy_deg[1]),
-                                 deg2rad(mount.rpy_deg[2])})
+  m.R_B_S = quat_from_euler_zyx(
+                {deg2rad(mount.rpy_deg[0]), deg2rad(mount.rpy_deg[1]), deg2rad(mount.rpy_deg[2])})
                 .toRotationMatrix();
   m.p_B = Vec3(mount.position_frd_m[0], mount.position_frd_m[1], mount.position_frd_m[2]);
   return m;

@@ -51,8 +51,8 @@ CompassSimulator::CompassSimulator(const CompassOptions& options, const RngStrea
     : options_((validate_sensor_options(options, "sensors." + name), options)),
       mount_(SensorMount::from_options(options.mount)),
       earth_W_(earth_field_ned_nt(options)),
-      soft_iron_(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
-          options.soft_iron.data())),
+      soft_iron_(
+          Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(options.soft_iron.data())),
       hard_iron_(options.hard_iron_nt[0], options.hard_iron_nt[1], options.hard_iron_nt[2]),
       field_noise_(rng.stream(name + ".field_noise")),
       heading_noise_(rng.stream(name + ".heading_noise")),
@@ -76,10 +76,9 @@ std::optional<CompassSample> CompassSimulator::measure(const BodySample& b) {
   for (int i = 0; i < 3; ++i) s.field_S_nt[i] += options_.field_noise_nt * field_noise_.normal();
   // The heading comes from the distorted but noise-free field: its noise is
   // sigma_deg by definition, not a by-product of field_noise_nt.
-  s.heading_rad = wrap_angle_rad(
-      tilt_compensated_heading_rad(distorted, e.roll_rad, e.pitch_rad,
-                                   deg2rad(options_.declination_deg)) +
-      deg2rad(options_.sigma_deg) * heading_noise_.normal());
+  s.heading_rad = wrap_angle_rad(tilt_compensated_heading_rad(distorted, e.roll_rad, e.pitch_rad,
+                                                              deg2rad(options_.declination_deg)) +
+                                 deg2rad(options_.sigma_deg) * heading_noise_.normal());
   const SampleTime t = clock_.stamp(b.t_ns);
   if (t.dropped) return std::nullopt;
   s.t_ns = t.t_stamp_ns;

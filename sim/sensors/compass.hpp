@@ -38,10 +38,10 @@ double tilt_compensated_heading_rad(const Vec3& field_S, double roll_rad, double
                                     double declination_rad);
 
 struct CompassSample {
-  TimeNs t_ns = 0;                // the compass clock's stamp
-  double heading_rad = 0.0;       // true heading of the sensor x axis, (-pi, pi]
-  Vec3 field_S_nt = Vec3::Zero(); // measured field in the sensor frame [nT]
-  double true_heading_rad = 0.0;  // ground truth: yaw of the sensor frame
+  TimeNs t_ns = 0;                 // the compass clock's stamp
+  double heading_rad = 0.0;        // true heading of the sensor x axis, (-pi, pi]
+  Vec3 field_S_nt = Vec3::Zero();  // measured field in the sensor frame [nT]
+  double true_heading_rad = 0.0;   // ground truth: yaw of the sensor frame
 };
 
 class CompassSimulator {

@@ -64,8 +64,8 @@ Constellation Constellation::orbits(int size, double period_s, double latitude_d
                                              std::cos(lat) * std::sin(lon), std::sin(lat));
   // Rows: north, east, down in ECEF.
   c.R_ned_ecef_ << -std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat),
-      -std::sin(lon), std::cos(lon), 0.0,
-      -std::cos(lat) * std::cos(lon), -std::cos(lat) * std::sin(lon), -std::sin(lat);
+      -std::sin(lon), std::cos(lon), 0.0, -std::cos(lat) * std::cos(lon),
+      -std::cos(lat) * std::sin(lon), -std::sin(lat);
   return c;
 }
 
@@ -83,7 +83,8 @@ std::vector<Vec3> Constellation::directions_ned(double t_s) const {
       const double cu = std::cos(u), su = std::sin(u), cO = std::cos(o.node_rad),
                    sO = std::sin(o.node_rad), ci = std::cos(o.inclination_rad),
                    si = std::sin(o.inclination_rad);
-      const Vec3 eci = kGpsOrbitRadius_m * Vec3(cO * cu - sO * su * ci, sO * cu + cO * su * ci, su * si);
+      const Vec3 eci =
+          kGpsOrbitRadius_m * Vec3(cO * cu - sO * su * ci, sO * cu + cO * su * ci, su * si);
       const Vec3 ecef(std::cos(theta) * eci.x() + std::sin(theta) * eci.y(),
                       -std::sin(theta) * eci.x() + std::cos(theta) * eci.y(), eci.z());
       out.push_back((R_ned_ecef_ * (ecef - receiver_ecef_m_)).normalized());
@@ -133,15 +134,13 @@ GpsSimulator::GpsSimulator(const GpsOptions& options, const RngStreams& rng,
     : options_((validate_sensor_options(options, "sensors." + name), options)),
       sky_(sky ? sky : &open_sky_),
       plane_({options.datum_lat_lon_h[0], options.datum_lat_lon_h[1], options.datum_lat_lon_h[2]}),
-      constellation_(options.constellation == ConstellationModel::kOrbits
-                         ? Constellation::orbits(options.constellation_size,
-                                                 options.constellation_period_s,
-                                                 options.datum_lat_lon_h[0],
-                                                 options.datum_lat_lon_h[1],
-                                                 rng.stream(name + ".constellation"))
-                         : Constellation(options.constellation_size, options.constellation_period_s,
-                                         options.datum_lat_lon_h[0],
-                                         rng.stream(name + ".constellation"))),
+      constellation_(
+          options.constellation == ConstellationModel::kOrbits
+              ? Constellation::orbits(options.constellation_size, options.constellation_period_s,
+                                      options.datum_lat_lon_h[0], options.datum_lat_lon_h[1],
+                                      rng.stream(name + ".constellation"))
+              : Constellation(options.constellation_size, options.constellation_period_s,
+                              options.datum_lat_lon_h[0], rng.stream(name + ".constellation"))),
       noise_(rng.stream(name + ".noise")),
       clock_(options.clock, rng, name),
       antenna_B_(options.antenna_frd_m[0], options.antenna_frd_m[1], options.antenna_frd_m[2]) {}

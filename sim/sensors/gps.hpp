@@ -49,8 +49,8 @@ class Constellation {
   /// Seen from the receiver at (lat, lon) on a spherical Earth that turns at
   /// the sidereal rate: above 52 deg N no satellite rises near the north
   /// celestial pole, so the northern sky is emptier than the southern.
-  static Constellation orbits(int size, double period_s, double latitude_deg,
-                              double longitude_deg, Rng rng);
+  static Constellation orbits(int size, double period_s, double latitude_deg, double longitude_deg,
+                              Rng rng);
 
   /// Unit vectors from the receiver towards each satellite at `t_s`, world NED.
   std::vector<Vec3> directions_ned(double t_s) const;
@@ -73,7 +73,9 @@ class Constellation {
 };
 
 /// Elevation [rad] of a unit direction in NED (positive above the horizon).
-inline double elevation_rad(const Vec3& u_ned) { return std::asin(std::clamp(-u_ned.z(), -1.0, 1.0)); }
+inline double elevation_rad(const Vec3& u_ned) {
+  return std::asin(std::clamp(-u_ned.z(), -1.0, 1.0));
+}
 
 /// Dilution of precision of a set of lines of sight (unit vectors, NED).
 struct Dop {
@@ -93,10 +95,10 @@ struct GpsFix {
   TimeNs t_valid_ns = 0;  // the instant the position describes
   bool fix = false;
   int satellites = 0;     // visible: above the mask and unobstructed
-  double hdop = kGpsNaN;      // of the visible set; NaN with fewer than 4 or a singular geometry
+  double hdop = kGpsNaN;  // of the visible set; NaN with fewer than 4 or a singular geometry
   Vec3 p_W = Vec3::Constant(kGpsNaN);  // reported antenna position, world NED [m]; NaN without fix
   Geodetic geodetic{kGpsNaN, kGpsNaN, kGpsNaN};  // the same on WGS84; NaN without fix
-  Vec3 p_true_W = Vec3::Zero();      // true antenna position (ground truth)
+  Vec3 p_true_W = Vec3::Zero();                  // true antenna position (ground truth)
 };
 
 class GpsSimulator {

@@ -40,8 +40,8 @@ ImuSample ideal_imu(const BodySample& b, const SensorMount& mount);
 
 /// Errors of one triad at the current sample (ground truth for estimators).
 struct ImuTriadState {
-  Vec3 bias = Vec3::Zero();       // current bias [rad/s or m/s^2]
-  Mat3 M = Mat3::Identity();      // scale and misalignment matrix, fixed at switch-on
+  Vec3 bias = Vec3::Zero();   // current bias [rad/s or m/s^2]
+  Mat3 M = Mat3::Identity();  // scale and misalignment matrix, fixed at switch-on
 };
 
 class ImuSimulator {

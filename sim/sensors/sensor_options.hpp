@@ -75,8 +75,7 @@ struct CameraNoiseOptions {
     a("full_well_e", full_well_e,
       "Electrons that give 255 DN at unit gain (the system gain is 255 / full_well_e DN/e-) [e-]",
       yaml::in_range(1, 1e7));
-    a("read_noise_e", read_noise_e, "Read noise standard deviation [e-]",
-      yaml::in_range(0, 1e4));
+    a("read_noise_e", read_noise_e, "Read noise standard deviation [e-]", yaml::in_range(0, 1e4));
     a("analog_gain", analog_gain, "Analog gain: multiplies DN per electron [-]",
       yaml::in_range(0.01, 1000));
     a("reference_exposure_ms", reference_exposure_ms,
@@ -225,7 +224,8 @@ constexpr auto enum_table(ConstellationModel) {
 
 enum class ImuPreset { kIdeal, kMpu9250, kAdis16448 };
 constexpr auto enum_table(ImuPreset) {
-  return std::array{std::pair{ImuPreset::kIdeal, "ideal"}, std::pair{ImuPreset::kMpu9250, "mpu9250"},
+  return std::array{std::pair{ImuPreset::kIdeal, "ideal"},
+                    std::pair{ImuPreset::kMpu9250, "mpu9250"},
                     std::pair{ImuPreset::kAdis16448, "adis16448"}};
 }
 

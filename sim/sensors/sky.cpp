@@ -59,16 +59,18 @@ std::optional<double> ray_triangle_distance(const Vec3& o, const Vec3& d, const 
 
 void PrimitiveObstruction::add_box(const Vec3& min_W, const Vec3& max_W) {
   if (!min_W.allFinite() || !max_W.allFinite() || (min_W.array() > max_W.array()).any())
-    throw UserError(fmt::format("sky obstruction box: got min {} and max {}, expected finite "
-                                "corners with min <= max on every axis",
-                                vec_text(min_W), vec_text(max_W)));
+    throw UserError(
+        fmt::format("sky obstruction box: got min {} and max {}, expected finite "
+                    "corners with min <= max on every axis",
+                    vec_text(min_W), vec_text(max_W)));
   boxes_.push_back({min_W, max_W});
 }
 
 void PrimitiveObstruction::add_triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
   if (!a.allFinite() || !b.allFinite() || !c.allFinite())
-    throw UserError(fmt::format("sky obstruction triangle: got {}, {}, {}, expected finite vertices",
-                                vec_text(a), vec_text(b), vec_text(c)));
+    throw UserError(
+        fmt::format("sky obstruction triangle: got {}, {}, {}, expected finite vertices",
+                    vec_text(a), vec_text(b), vec_text(c)));
   triangles_.push_back({a, b, c});
 }
 

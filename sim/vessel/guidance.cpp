@@ -99,8 +99,8 @@ std::vector<MissionSegment> plan_mission(const MissionOptions& m, const Vec2& st
     case MissionType::kWaypoints: {
       const auto& w = m.waypoints_ne_m;
       if (w.size() < 2)
-        throw UserError(fmt::format("mission.waypoints_ne_m: got {} waypoints, expected at least 2",
-                                    w.size()));
+        throw UserError(
+            fmt::format("mission.waypoints_ne_m: got {} waypoints, expected at least 2", w.size()));
       Vec2 p = start;
       for (const auto& q : w) {
         add_leg(&out, p, Vec2(q[0], q[1]), m.speed_mps);
@@ -168,7 +168,8 @@ VesselInputs Guidance::update(const VesselState& s, double t, double dt) {
       heading_d_ = std::atan2(t_hat.y(), t_hat.x()) - std::atan(cross_track_m_ / c.lookahead_m);
       const auto& weave = mission_.yaw_weave;
       if (weave.amplitude_deg > 0)
-        heading_d_ += deg2rad(weave.amplitude_deg) * std::sin(2 * std::numbers::pi * t / weave.period_s);
+        heading_d_ +=
+            deg2rad(weave.amplitude_deg) * std::sin(2 * std::numbers::pi * t / weave.period_s);
       speed_d = seg.speed_mps;
       break;
     }

@@ -18,7 +18,7 @@ struct MissionSegment {
   Vec2 from = Vec2::Zero();  // north, east [m] (legs and tow)
   Vec2 to = Vec2::Zero();
   double speed_mps = 0;
-  double heading_rad = 0;    // target heading (turns)
+  double heading_rad = 0;  // target heading (turns)
 };
 
 /// Geometry of the world the mission is planned in.

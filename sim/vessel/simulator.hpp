@@ -34,7 +34,7 @@ struct MotionSummary {
   bool mission_completed = false;
   std::size_t steps = 0;
   double duration_s = 0;
-  double distance_m = 0;      // path length of the CG
+  double distance_m = 0;  // path length of the CG
   double mean_speed_mps = 0;
   std::string brief() const;
 };

@@ -23,15 +23,15 @@ VesselModel::VesselModel(const VesselOptions& options) : options_(options) {
   const double m = options_.mass_kg;
   const double draft = m / (kRho * h.length_m * h.beam_m);
   if (draft >= h.depth_m)
-    throw UserError(fmt::format(
-        "vessel.mass_kg: got {} kg, expected a mass the {} x {} x {} m hull can float "
-        "(at most {:.1f} kg)",
-        m, h.length_m, h.beam_m, h.depth_m, kRho * h.length_m * h.beam_m * h.depth_m));
+    throw UserError(
+        fmt::format("vessel.mass_kg: got {} kg, expected a mass the {} x {} x {} m hull can float "
+                    "(at most {:.1f} kg)",
+                    m, h.length_m, h.beam_m, h.depth_m, kRho * h.length_m * h.beam_m * h.depth_m));
   const auto& r = options_.gyration_radii_m;
   inertia_ = Vec3(m * r[0] * r[0], m * r[1] * r[1], m * r[2] * r[2]);
   const auto& A = options_.added_mass;
-  const double diag[6] = {m + A[0],           m + A[1],           m + A[2],
-                          inertia_.x() + A[3], inertia_.y() + A[4], inertia_.z() + A[5]};
+  const double diag[6] = {
+      m + A[0], m + A[1], m + A[2], inertia_.x() + A[3], inertia_.y() + A[4], inertia_.z() + A[5]};
   for (int i = 0; i < 6; ++i) {
     M_(i, i) = diag[i];
     M_inv_(i, i) = 1.0 / diag[i];
@@ -45,7 +45,8 @@ VesselModel::VesselModel(const VesselOptions& options) : options_(options) {
     const double x = -L / 2 + L * (i + 0.5) / na;
     for (int j = 0; j < nc; ++j) {
       const double y = -B / 2 + B * (j + 0.5) / nc;
-      panels_.push_back({Vec3(x, y, keel), Vec3::Zero(), Vec3(0, 0, 1), (L / na) * (B / nc), false});
+      panels_.push_back(
+          {Vec3(x, y, keel), Vec3::Zero(), Vec3(0, 0, 1), (L / na) * (B / nc), false});
     }
     panels_.push_back({Vec3(x, -B / 2, keel), up, Vec3(0, -1, 0), L / na, true});
     panels_.push_back({Vec3(x, B / 2, keel), up, Vec3(0, 1, 0), L / na, true});
@@ -202,8 +203,8 @@ VesselStateDot VesselModel::derivative(const VesselState& s, const VesselInputs&
   d.w_dot = nu_dot.tail<3>();
   const auto& th = options_.thrusters;
   for (int i = 0; i < 2; ++i) {
-    const double cmd = std::clamp(in.thrust_command_n[i], -th.reverse_fraction * th.max_thrust_n,
-                                  th.max_thrust_n);
+    const double cmd =
+        std::clamp(in.thrust_command_n[i], -th.reverse_fraction * th.max_thrust_n, th.max_thrust_n);
     d.thrust_dot[i] = (cmd - s.thrust_n[i]) / th.time_constant_s;
   }
   return d;
@@ -227,7 +228,7 @@ double VesselModel::calm_water_energy(const VesselState& s, int nu, int nv) cons
     for (int j = 0; j < nv; ++j) {
       const double v = -h.beam_m / 2 + (j + 0.5) * dv;
       const double z0 = s.p_W.z() + R(2, 0) * u + R(2, 1) * v;  // depth at w = 0
-      const double c = R(2, 2);                                    // d depth / d w
+      const double c = R(2, 2);                                 // d depth / d w
       // Submerged where z0 + c w > 0, for w in [w_top, w_bot].
       double lo = w_top, hi = w_bot;
       if (std::abs(c) < 1e-15) {

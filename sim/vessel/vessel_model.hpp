@@ -28,10 +28,10 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 
 /// Rigid-body state: pose of the body (CG, FRD) in the world (NED) and body velocities.
 struct VesselState {
-  Vec3 p_W = Vec3::Zero();             // position of the CG [m]
-  Quat q_W_B = Quat::Identity();       // attitude
-  Vec3 v_B = Vec3::Zero();             // linear velocity in body axes [m/s]
-  Vec3 w_B = Vec3::Zero();             // angular velocity of B in B [rad/s]
+  Vec3 p_W = Vec3::Zero();               // position of the CG [m]
+  Quat q_W_B = Quat::Identity();         // attitude
+  Vec3 v_B = Vec3::Zero();               // linear velocity in body axes [m/s]
+  Vec3 w_B = Vec3::Zero();               // angular velocity of B in B [rad/s]
   std::array<double, 2> thrust_n{0, 0};  // actual thrust of port, starboard thrusters [N]
 
   SE3 T_W_B() const { return SE3(q_W_B, p_W); }
@@ -50,7 +50,7 @@ struct VesselStateDot {
 struct VesselInputs {
   std::array<double, 2> thrust_command_n{0, 0};  // port, starboard
   bool tow_active = false;
-  Vec3 tow_carriage_W = Vec3::Zero();      // carriage position at t = 0 [m]
+  Vec3 tow_carriage_W = Vec3::Zero();  // carriage position at t = 0 [m]
   Vec3 tow_carriage_velocity_W = Vec3::Zero();
 };
 
@@ -107,7 +107,9 @@ class VesselModel {
                            int columns_across = 150) const;
 
   /// World positions of the thruster and tow attachment points.
-  Vec3 tow_point_B() const { return Vec3(options_.tow.attach_x_m, 0, -options_.hull.depth_m + options_.hull.kg_m); }
+  Vec3 tow_point_B() const {
+    return Vec3(options_.tow.attach_x_m, 0, -options_.hull.depth_m + options_.hull.kg_m);
+  }
 
  private:
   struct Panel {   // a flat piece of the hull, in body axes

@@ -138,8 +138,8 @@ struct VesselOptions {
     a("mass_kg", mass_kg, "Mass [kg]", yaml::positive());
     a("gyration_radii_m", gyration_radii_m, "Radii of gyration about body x, y, z [m]",
       yaml::positive());
-    a("added_mass", added_mass,
-      "Diagonal added mass A11, A22, A33 [kg] and A44, A55, A66 [kg m^2]", yaml::non_negative());
+    a("added_mass", added_mass, "Diagonal added mass A11, A22, A33 [kg] and A44, A55, A66 [kg m^2]",
+      yaml::non_negative());
     a("linear_damping", linear_damping,
       "Linear damping surge, sway, heave [N s/m], roll, pitch, yaw [N m s/rad]",
       yaml::non_negative());
@@ -165,8 +165,12 @@ inline VesselOptions VesselOptions::preset_defaults(VesselPreset preset) {
     o.added_mass = {0.4, 4.0, 8.0, 0.0065, 0.58, 0.22};
     o.linear_damping = {2.0, 20.0, 35.0, 0.12, 2.0, 1.0};
     o.quadratic_damping = {4.0, 20.0, 0.0, 0.0, 0.0, 1.0};
-    o.hull = {.length_m = 1.2, .beam_m = 0.25, .depth_m = 0.15, .kg_m = 0.06,
-              .panels_along = 24, .panels_across = 6};
+    o.hull = {.length_m = 1.2,
+              .beam_m = 0.25,
+              .depth_m = 0.15,
+              .kg_m = 0.06,
+              .panels_along = 24,
+              .panels_across = 6};
     o.thrusters.max_thrust_n = 0.0;
     o.control.lookahead_m = 1.0;
   }
@@ -179,7 +183,8 @@ enum class MissionType { kStraight, kTransects, kSurvey, kTow, kSpin, kWaypoints
 constexpr auto enum_table(MissionType) {
   return std::array{std::pair{MissionType::kStraight, "straight"},
                     std::pair{MissionType::kTransects, "transects"},
-                    std::pair{MissionType::kSurvey, "survey"}, std::pair{MissionType::kTow, "tow"},
+                    std::pair{MissionType::kSurvey, "survey"},
+                    std::pair{MissionType::kTow, "tow"},
                     std::pair{MissionType::kSpin, "spin"},
                     std::pair{MissionType::kWaypoints, "waypoints"}};
 }

@@ -68,8 +68,7 @@ struct WaveOptions {
     a("mean_direction_deg", mean_direction_deg, "JONSWAP mean direction of travel [deg]",
       yaml::in_range(-360, 360));
     a("spreading_s", spreading_s, "cos-2s directional spreading exponent s", yaml::positive());
-    a("num_frequencies", num_frequencies, "JONSWAP frequency components",
-      yaml::in_range(1, 4096));
+    a("num_frequencies", num_frequencies, "JONSWAP frequency components", yaml::in_range(1, 4096));
     a("num_directions", num_directions, "JONSWAP direction components", yaml::in_range(1, 512));
     // Linear theory needs water under every trough: a trough that reaches the
     // bottom is not a wave this model can describe.

@@ -1,12 +1,12 @@
 // Runs the `driftlab` executable as a user would and checks exit codes,
 // messages and files written.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <sys/wait.h>
+#include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <algorithm>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -86,8 +86,9 @@ TEST(Cli, EveryShippedScenarioIsValid) {
 
 TEST(Cli, CheckPrintsResolvedScenarioThatChecksAgain) {
   const fs::path dir = fresh_temp_dir("resolved");
-  const Result r = run_cli({"scenario", "check", (kSource / "scenarios/river_crossing.yaml").string(),
-                            "--set", "sensors.camera.baseline_m=0.2"});
+  const Result r =
+      run_cli({"scenario", "check", (kSource / "scenarios/river_crossing.yaml").string(), "--set",
+               "sensors.camera.baseline_m=0.2"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.out.find("baseline_m: 0.2  # Stereo baseline B [m]"), std::string::npos);
   EXPECT_NE(r.out.find("section_length_m: 6.5"), std::string::npos);
@@ -129,8 +130,8 @@ TEST(Cli, RunWritesAtomicallyAndRefusesToOverwrite) {
   const fs::path dir = fresh_temp_dir("run");
   const std::string file = (kSource / "scenarios/river_crossing.yaml").string();
   const fs::path out = dir / "out";
-  Result r = run_cli({"run", file, "--out", out.string(), "--seed", "99", "--set",
-                      "pipeline.max_frames=10"});
+  Result r = run_cli(
+      {"run", file, "--out", out.string(), "--seed", "99", "--set", "pipeline.max_frames=10"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(fs::exists(out / "scenario.resolved.yaml"));
   EXPECT_NE(read_text(out / "metrics.json").find("\"seed\": 99"), std::string::npos);
@@ -155,8 +156,8 @@ TEST(Cli, KilledRunLeavesNoOutputFolder) {
   const fs::path log = dir / "log";
   const std::string cmd = shell_quote(kCli.string()) + " run " +
                           shell_quote((kSource / "scenarios/river_crossing.yaml").string()) +
-                          " --out " + shell_quote(out.string()) + " > " + shell_quote(log.string()) +
-                          " 2>&1 & pid=$!; " +
+                          " --out " + shell_quote(out.string()) + " > " +
+                          shell_quote(log.string()) + " 2>&1 & pid=$!; " +
                           // wait until the frame loop reports progress, then kill
                           "for i in $(seq 1 600); do grep -q frames " + shell_quote(log.string()) +
                           " && break; sleep 0.1; done; kill -9 $pid; wait $pid";
@@ -218,9 +219,9 @@ void write_tum_pair(const fs::path& dir) {
 TEST(CliEval, WritesMetricsSectionsAndTables) {
   const fs::path dir = fresh_temp_dir("eval");
   write_tum_pair(dir);
-  const Result r = run_cli({"eval", "--gt", (dir / "gt.tum").string(), "--est",
-                            (dir / "est.tum").string(), "--align", "none", "--out",
-                            (dir / "out").string()});
+  const Result r =
+      run_cli({"eval", "--gt", (dir / "gt.tum").string(), "--est", (dir / "est.tum").string(),
+               "--align", "none", "--out", (dir / "out").string()});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string metrics = read_text(dir / "out/metrics.json");
   EXPECT_NE(metrics.find("\"p_m_per_m\""), std::string::npos);
@@ -263,9 +264,9 @@ TEST(CliRender, SameBytesWithOneOrTwoRasterThreads) {
   const fs::path dir = fresh_temp_dir("render_threads");
   const std::string file = (kSource / "scenarios/river_crossing.yaml").string();
   for (const char* n : {"1", "2"}) {
-    const Result r = run_cli({"render", file, "--frames", "3", "--depth", "--out",
-                              (dir / n).string()},
-                             std::string("LP_NUM_THREADS=") + n);
+    const Result r =
+        run_cli({"render", file, "--frames", "3", "--depth", "--out", (dir / n).string()},
+                std::string("LP_NUM_THREADS=") + n);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.out.find("rendered 3 stereo pairs"), std::string::npos) << r.out;
   }

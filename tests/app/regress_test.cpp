@@ -217,9 +217,9 @@ TEST_F(Regress, StandaloneGateBinaryMatchesRegressAndLinksNoRendererCeresOrAssim
   write_baseline();
   write_results(0.0112, 0.44, 7.6);
   const Result via_driftlab = gate();
-  const Result alone = driftlab::test::run_shell(
-      shell_quote(gate_bin.string()) + " --baseline " + shell_quote(baseline().string()) +
-      " --results " + shell_quote((dir_ / "run").string()));
+  const Result alone = driftlab::test::run_shell(shell_quote(gate_bin.string()) + " --baseline " +
+                                                 shell_quote(baseline().string()) + " --results " +
+                                                 shell_quote((dir_ / "run").string()));
   EXPECT_EQ(alone.exit_code, 1) << alone.output;
   EXPECT_EQ(alone.exit_code, via_driftlab.exit_code);
   EXPECT_EQ(alone.out, via_driftlab.out);

@@ -21,8 +21,8 @@ Trajectory serpentine() {
   for (int i = 0; i < 400; ++i) {
     heading = 0.8 * std::sin(i * 0.02);
     const Mat3 R_W_F = Eigen::AngleAxisd(heading, Vec3::UnitZ()).toRotationMatrix();
-    t.push_back({static_cast<TimeNs>(i) * 500'000'000,
-                 SE3(Mat3(R_W_F * R_optical_frd().transpose()), p)});
+    t.push_back(
+        {static_cast<TimeNs>(i) * 500'000'000, SE3(Mat3(R_W_F * R_optical_frd().transpose()), p)});
     p += R_W_F * Vec3(0.5, 0, 0);
     p.z() = 0.05 * std::sin(i * 0.3);  // a little heave
   }
@@ -69,7 +69,8 @@ TEST(Evaluate, ScaledEstimateGivesItsScaleErrorPerMetreAndSim3UndoesIt) {
   // section's path length (the arc).
   ASSERT_GT(e.sections.size(), 25u);
   for (const auto& sec : e.sections) {
-    const double chord = (gt[sec.last].T_W_C.translation() - gt[sec.first].T_W_C.translation()).norm();
+    const double chord =
+        (gt[sec.last].T_W_C.translation() - gt[sec.first].T_W_C.translation()).norm();
     EXPECT_NEAR(sec.err_p_m, 0.05 * chord, 1e-9);
   }
   EXPECT_LE(e.section_summary.p_m_per_m.max, 0.05);
@@ -80,8 +81,8 @@ TEST(Evaluate, JsonHasTheDocumentedKeysAndNoNonFiniteNumbers) {
   const Trajectory gt = serpentine();
   Trajectory est = gt;
   for (std::size_t i = 0; i < est.size(); ++i)
-    est[i].T_W_C = SE3(est[i].T_W_C.quaternion(),
-                       est[i].T_W_C.translation() + Vec3(0.001 * i, 0, 0));
+    est[i].T_W_C =
+        SE3(est[i].T_W_C.quaternion(), est[i].T_W_C.translation() + Vec3(0.001 * i, 0, 0));
   EvaluationInput in = input_with(gt, est);
   in.options.subtracks.push_back({"first_minute", 0, 60});
   const Evaluation e = evaluate(in);
@@ -154,7 +155,8 @@ TEST(Evaluate, NonFiniteValuesBecomeNullWithAWarning) {
   const nlohmann::json j = to_json(e, {});
   EXPECT_TRUE(j["ape"]["trans_m"]["rmse"].is_null());
   bool warned = false;
-  for (const auto& w : j["warnings"]) warned = warned || w.get<std::string>().find("ape.trans_m.rmse") != std::string::npos;
+  for (const auto& w : j["warnings"])
+    warned = warned || w.get<std::string>().find("ape.trans_m.rmse") != std::string::npos;
   EXPECT_TRUE(warned);
 }
 

@@ -115,8 +115,8 @@ TEST(Sections, CovariatesFromTheFrameTable) {
 }
 
 TEST(Sections, ReadsFrameTableAndRejectsBadFiles) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("driftlab_frames_" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("driftlab_frames_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const auto file = (dir / "frames.csv").string();
   std::ofstream(file) << "t,inliers,mean_depth_m\n0.5,100,20.5\n1.0,,nan\n";

@@ -46,7 +46,8 @@ FrameTruth frame(double yaw_rate_rad_s = 0.0) {
 
 struct Rendering {
   explicit Rendering(const Scenario& sc)
-      : scene(scenes::build_scene(sc.scene, sc.seed, -10, 30)), renderer(rig_of(sc.sensors.camera), sc.render) {
+      : scene(scenes::build_scene(sc.scene, sc.seed, -10, 30)),
+        renderer(rig_of(sc.sensors.camera), sc.render) {
     renderer.upload(scene);
   }
   sim::SceneGeometry scene;
@@ -156,7 +157,8 @@ TEST(CameraStage, AutoExposureSettlesOnTheTargetMean) {
     for (std::uint8_t v : g.pixels) m += v;
     return m / static_cast<double>(g.pixels.size());
   };
-  const double reference_mean = mean_of(CameraStage(sc, &r.renderer, RngStreams(1)).capture(frame()).left);
+  const double reference_mean =
+      mean_of(CameraStage(sc, &r.renderer, RngStreams(1)).capture(frame()).left);
   sc.sensors.camera.auto_exposure.enabled = true;
   sc.sensors.camera.auto_exposure.target_mean_dn = 80;
   sc.sensors.camera.exposure_ms = 40;  // 8x the reference exposure of 5 ms
@@ -182,7 +184,8 @@ TEST(CameraStage, RunStampsFramesWithTheCameraClockAndSkipsDroppedOnes) {
   sc.sensors.camera.clock.drop_probability = 0.2;
   EXPECT_THROW(validate_scenario(sc, "test"), UserError);  // 30 ms > the 20 ms tolerance
   sc.eval.association_tolerance_s = 0.035;
-  const fs::path out = fs::temp_directory_path() / ("driftlab_camera_clock_" + std::to_string(::getpid()));
+  const fs::path out =
+      fs::temp_directory_path() / ("driftlab_camera_clock_" + std::to_string(::getpid()));
   fs::remove_all(out);
   run_scenario(sc, out, {});
   const Trajectory gt = read_tum(out / "groundtruth.tum");

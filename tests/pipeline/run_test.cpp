@@ -78,10 +78,10 @@ TEST(Run, SameSeedSameBytes) {
   const Scenario sc = short_crossing(30);
   run_scenario(sc, a, {});
   run_scenario(sc, b, {});
-  for (const char* f : {"groundtruth.tum", "body_groundtruth.csv", "scenario.resolved.yaml",
-                        "estimates/sparse.tum", "estimates/sparse_ca.tum", "sections.csv",
-                        "imu.csv", "gps.csv", "compass.csv", "plots/data/sparse.dat",
-                        "plots/plots.gp"})
+  for (const char* f :
+       {"groundtruth.tum", "body_groundtruth.csv", "scenario.resolved.yaml", "estimates/sparse.tum",
+        "estimates/sparse_ca.tum", "sections.csv", "imu.csv", "gps.csv", "compass.csv",
+        "plots/data/sparse.dat", "plots/plots.gp"})
     EXPECT_EQ(slurp(a / f), slurp(b / f)) << f;
   // metrics.json too, apart from the wall-clock figures under "timing".
   auto metrics = [](const fs::path& d) {
@@ -113,9 +113,9 @@ TEST(Run, SensorsSampleAtTheirRatesFromTheSameGroundTruth) {
   const std::string imu = slurp(out / "imu.csv");
   const std::string first = imu.substr(imu.find('\n') + 1, imu.find('\n', imu.find('\n') + 1));
   double t, wx, wy, wz, ax, ay, az;
-  ASSERT_EQ(std::sscanf(first.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &t, &wx, &wy, &wz, &ax, &ay,
-                        &az),
-            7);
+  ASSERT_EQ(
+      std::sscanf(first.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &t, &wx, &wy, &wz, &ax, &ay, &az),
+      7);
   EXPECT_NEAR(az, -9.80665, 0.05);
   EXPECT_NEAR(std::hypot(wx, wy, wz), 0.0, 1e-3);
   const auto metrics = nlohmann::json::parse(slurp(out / "metrics.json"));
@@ -144,7 +144,6 @@ TEST(Run, WholeDischargeMeasurementMission) {
   EXPECT_NEAR(sum.motion.distance_m, 54.0, 2.0);  // + overshoot at the ends of the legs
   fs::remove_all(out);
 }
-
 
 // The end-to-end acceptance run: a straight calm-water leg of 420 frames
 // (16 m at 0.5 m/s past the river reach, two 6.5 m sections) through every
@@ -196,7 +195,8 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractWithSaneErrors) {
   std::istringstream frames(slurp(out / "frames.csv"));
   std::string header, line;
   std::getline(frames, header);
-  for (const char* col : {"t_ns", "render_ms", "sparse_valid", "sparse_inliers", "sparse_mean_depth_m"})
+  for (const char* col :
+       {"t_ns", "render_ms", "sparse_valid", "sparse_inliers", "sparse_mean_depth_m"})
     EXPECT_NE(header.find(col), std::string::npos) << col;
   int rows = 0;
   while (std::getline(frames, line)) rows += line.empty() ? 0 : 1;

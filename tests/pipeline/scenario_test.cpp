@@ -44,8 +44,8 @@ TEST(Scenario, LoadsTheDemoScenario) {
 
 TEST(Scenario, BasinExperimentsMatchThePaperTable) {
   // Kucic and Valcic (2020), Table 1: (gamma [deg], zeta_a [mm], lambda [mm]).
-  const double table[7][3] = {{0, 0, 0},    {40, 5, 210}, {40, 7.5, 132}, {40, 11, 59},
-                              {0, 5, 210},  {0, 7.5, 132}, {0, 11, 59}};
+  const double table[7][3] = {{0, 0, 0},   {40, 5, 210},  {40, 7.5, 132}, {40, 11, 59},
+                              {0, 5, 210}, {0, 7.5, 132}, {0, 11, 59}};
   for (int i = 0; i < 7; ++i) {
     const Scenario s =
         load_scenario(kSource / ("scenarios/basin_exp" + std::to_string(i + 1) + ".yaml"));
@@ -65,9 +65,9 @@ TEST(Scenario, BasinExperimentsMatchThePaperTable) {
 }
 
 TEST(Scenario, OverridesApplyInOrderAfterTheFile) {
-  const Scenario s = parse_scenario("seed: 5\nsensors: {camera: {rate_hz: 10}}\n", "s.yaml",
-                                    fs::temp_directory_path(),
-                                    {"seed=6", "seed=7", "sensors.camera.rate_hz=20"});
+  const Scenario s =
+      parse_scenario("seed: 5\nsensors: {camera: {rate_hz: 10}}\n", "s.yaml",
+                     fs::temp_directory_path(), {"seed=6", "seed=7", "sensors.camera.rate_hz=20"});
   EXPECT_EQ(s.seed, 7u);
   EXPECT_DOUBLE_EQ(s.sensors.camera.rate_hz, 20.0);
 }
@@ -109,8 +109,7 @@ TEST(Scenario, WaypointsFileIsReadRelativeToTheScenarioAndInlined) {
     load_scenario(dir / "s.yaml");
     FAIL();
   } catch (const UserError& e) {
-    EXPECT_NE(std::string(e.what()).find("wp.csv:1: got 3 columns, expected 2"),
-              std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("wp.csv:1: got 3 columns, expected 2"), std::string::npos)
         << e.what();
   }
   fs::remove_all(dir);

@@ -1,12 +1,11 @@
 // Report pieces of a run: Markdown tables to HTML, gnuplot plots.
-#include "report/gnuplot.hpp"
 #include "report/run_report.hpp"
+#include "report/gnuplot.hpp"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
-
 
 namespace driftlab::report {
 namespace {

@@ -59,10 +59,11 @@ TEST(CameraSensor, FlatGreyImageVarianceMatchesTheNoiseModel) {
     const double expected_mean = cs.grey * cs.gain * cs.exposure_ms / 5.0;
     const double expected_var = expected_variance(c, expected_mean);
     const double measured_var = sd[0] * sd[0];
-    std::printf("grey %3d gain %.0f exposure %.1f ms read %2.0f e-: mean %.3f (model %.3f), "
-                "variance %.4f (model %.4f, ratio %.4f)\n",
-                cs.grey, cs.gain, cs.exposure_ms, cs.read_noise_e, mean[0], expected_mean,
-                measured_var, expected_var, measured_var / expected_var);
+    std::printf(
+        "grey %3d gain %.0f exposure %.1f ms read %2.0f e-: mean %.3f (model %.3f), "
+        "variance %.4f (model %.4f, ratio %.4f)\n",
+        cs.grey, cs.gain, cs.exposure_ms, cs.read_noise_e, mean[0], expected_mean, measured_var,
+        expected_var, measured_var / expected_var);
     EXPECT_NEAR(mean[0], expected_mean, 0.05);
     EXPECT_NEAR(measured_var / expected_var, 1.0, 0.05);
     EXPECT_NEAR(noise.model().noise_variance_dn2(expected_mean), expected_var, 1e-12);
@@ -116,7 +117,8 @@ TEST(CameraSensor, VignettingFollowsTheCos4Law) {
   // Half strength: half the fall-off.
   c.vignetting_strength = 0.5;
   const PhotometricModel half(c);
-  const double corner = std::pow(std::cos(std::atan(std::hypot(c.cx_px / c.fx_px, c.cy_px / c.fy_px))), 4);
+  const double corner =
+      std::pow(std::cos(std::atan(std::hypot(c.cx_px / c.fx_px, c.cy_px / c.fy_px))), 4);
   EXPECT_NEAR(half.vignetting(0, 0), 1 - 0.5 * (1 - corner), 1e-12);
   EXPECT_DOUBLE_EQ(half.vignetting(c.cx_px, c.cy_px), 1.0);
 }

@@ -20,9 +20,9 @@ namespace {
 
 namespace fs = std::filesystem;
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kA = 6378137.0;                 // WGS84 semi-major axis [m]
-constexpr double kB = 6356752.314245179;         // WGS84 semi-minor axis [m], a (1 - f)
-constexpr double kE2 = 6.69437999014e-3;         // WGS84 first eccentricity squared
+constexpr double kA = 6378137.0;          // WGS84 semi-major axis [m]
+constexpr double kB = 6356752.314245179;  // WGS84 semi-minor axis [m], a (1 - f)
+constexpr double kE2 = 6.69437999014e-3;  // WGS84 first eccentricity squared
 
 BodySample body_at(const Vec3& p_W, TimeNs t_ns) {
   BodySample b;
@@ -148,8 +148,9 @@ TEST(GpsSensor, OrbitsLeaveTheNorthernHoleAndKeepAFixInOpenSky) {
     }
     min_visible = std::min(min_visible, visible);
   }
-  std::printf("orbits from 52 N, a day: %d sightings due north, %d due south, at least %d above 10 deg\n",
-              north, south, min_visible);
+  std::printf(
+      "orbits from 52 N, a day: %d sightings due north, %d due south, at least %d above 10 deg\n",
+      north, south, min_visible);
   EXPECT_EQ(north, 0);
   EXPECT_GT(south, 100);
   EXPECT_GE(min_visible, 5);
@@ -245,7 +246,8 @@ TEST(GpsSensor, NoFixBelowFourSatellitesNorAboveMaxHdop) {
   GpsSimulator gps(o, RngStreams(2), &canyon);
   bool saw_few = false, saw_fix = false;
   for (int k = 0; k < 400; ++k) {
-    const auto f = gps.measure(body_at(Vec3(k + 0.5, 0, 0), static_cast<TimeNs>(k) * 1'000'000'000));
+    const auto f =
+        gps.measure(body_at(Vec3(k + 0.5, 0, 0), static_cast<TimeNs>(k) * 1'000'000'000));
     ASSERT_TRUE(f.has_value());
     const bool expected = f->satellites >= 4 && std::isfinite(f->hdop) && f->hdop <= o.max_hdop;
     EXPECT_EQ(f->fix, expected) << "north " << k << ", " << f->satellites << " satellites";

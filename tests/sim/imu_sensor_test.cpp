@@ -95,9 +95,10 @@ WavyRun wavy_run(double rate_hz, double seconds) {
   WaveOptions w;
   w.model = WaveModel::kComponents;
   w.water_depth_m = 3.0;
-  w.components = {{.amplitude_m = 0.065, .wavelength_m = 12.0, .direction_deg = 40},
-                  {.amplitude_m = 0.04, .wavelength_m = 8.0, .direction_deg = -70, .phase_deg = 30},
-                  {.amplitude_m = 0.025, .wavelength_m = 5.0, .direction_deg = 160, .phase_deg = 100}};
+  w.components = {
+      {.amplitude_m = 0.065, .wavelength_m = 12.0, .direction_deg = 40},
+      {.amplitude_m = 0.04, .wavelength_m = 8.0, .direction_deg = -70, .phase_deg = 30},
+      {.amplitude_m = 0.025, .wavelength_m = 5.0, .direction_deg = 160, .phase_deg = 100}};
   const auto waves = make_wave_field(w, RngStreams(7).stream("waves.phases"));
   Environment env;
   env.waves = waves.get();
@@ -173,7 +174,9 @@ TEST(ImuSensor, StrapdownOfNoiseFreeImuRecoversTheWavyTrajectory) {
   // Truth of the IMU frame from the body ground truth and the mount, here.
   const Mat3 R_B_S = rot_zyx(3 * kDeg, -5 * kDeg, 95 * kDeg);
   const Vec3 r_B(0.45, -0.2, -0.35);
-  auto truth_q = [&](const BodySample& b) { return Quat(b.state.q_W_B.toRotationMatrix() * R_B_S); };
+  auto truth_q = [&](const BodySample& b) {
+    return Quat(b.state.q_W_B.toRotationMatrix() * R_B_S);
+  };
   auto truth_p = [&](const BodySample& b) { return Vec3(b.state.p_W + b.state.q_W_B * r_B); };
 
   const BodySample& b0 = run.samples.front();
@@ -215,8 +218,9 @@ TEST(ImuSensor, StrapdownOfNoiseFreeImuRecoversTheWavyTrajectory) {
   EXPECT_GT(max_pitch, 2 * kDeg);
   RecordProperty("max_position_error_m", std::to_string(max_p));
   RecordProperty("max_attitude_error_rad", std::to_string(max_q));
-  std::printf("strapdown over %.0f s, %.1f m of track: max position error %.3g m, attitude %.3g rad\n",
-              seconds, path, max_p, max_q);
+  std::printf(
+      "strapdown over %.0f s, %.1f m of track: max position error %.3g m, attitude %.3g rad\n",
+      seconds, path, max_p, max_q);
   EXPECT_LT(max_p, 1e-3);
   EXPECT_LT(max_q, 1e-4);
 }
@@ -267,7 +271,8 @@ AllanFit fit_allan(const std::vector<std::vector<double>>& axes, double tau0) {
     a /= static_cast<double>(thetas.size());
     tau.push_back(static_cast<double>(m) * tau0);
     avar.push_back(a);
-    dof.push_back(static_cast<double>(thetas.size()) * static_cast<double>(n) / static_cast<double>(m));
+    dof.push_back(static_cast<double>(thetas.size()) * static_cast<double>(n) /
+                  static_cast<double>(m));
   }
   {
     const auto m1 = static_cast<std::size_t>(std::llround(1.0 / tau0));
@@ -331,10 +336,10 @@ TEST(ImuSensor, AllanDeviationOfAStaticHourRecoversTheNoiseModel) {
     const ImuOptions o = ImuOptions::preset_defaults(preset);
     const AllanRatios r = static_hour(o, 3);
     const std::string name(yaml::enum_name(preset));
-    std::printf("%s Allan fit / configured: gyro N %.4f K %.4f, accel N %.4f K %.4f; "
-                "sigma(1 s) / N: gyro %.4f accel %.4f\n",
-                name.c_str(), r.gyro_n, r.gyro_k, r.accel_n, r.accel_k, r.gyro_sigma1,
-                r.accel_sigma1);
+    std::printf(
+        "%s Allan fit / configured: gyro N %.4f K %.4f, accel N %.4f K %.4f; "
+        "sigma(1 s) / N: gyro %.4f accel %.4f\n",
+        name.c_str(), r.gyro_n, r.gyro_k, r.accel_n, r.accel_k, r.gyro_sigma1, r.accel_sigma1);
     EXPECT_NEAR(r.gyro_n, 1.0, 0.1) << name;
     EXPECT_NEAR(r.gyro_k, 1.0, 0.1) << name;
     EXPECT_NEAR(r.accel_n, 1.0, 0.1) << name;

@@ -38,8 +38,14 @@ Mesh disc(const Vec3& c, double radius, int segments = 64) {
   m.name = "marker";
   m.material.albedo = 1.0f;
   auto vert = [&](double e, double d) {
-    return Vertex{static_cast<float>(c.x()), static_cast<float>(c.y() + e),
-                  static_cast<float>(c.z() + d), -1.f, 0.f, 0.f, 0.f, 0.f};
+    return Vertex{static_cast<float>(c.x()),
+                  static_cast<float>(c.y() + e),
+                  static_cast<float>(c.z() + d),
+                  -1.f,
+                  0.f,
+                  0.f,
+                  0.f,
+                  0.f};
   };
   m.vertices.push_back(vert(0, 0));
   for (int i = 0; i < segments; ++i) {
@@ -113,8 +119,8 @@ TEST_F(RenderTest, MarkerLandsOnItsPinholeProjectionInBothImages) {
   EXPECT_NEAR(cr.y(), uv_r.y(), 0.1);
   // Disparity = fx B / Z, river paper Eq. (1).
   EXPECT_NEAR(cl.x() - cr.x(), 500 * 0.12 / 10.0, 0.1);
-  std::cout << "marker: left (" << cl.x() << ", " << cl.y() << ") vs (" << uv.x() << ", "
-            << uv.y() << "), disparity " << cl.x() - cr.x() << " vs " << 6.0 << "\n";
+  std::cout << "marker: left (" << cl.x() << ", " << cl.y() << ") vs (" << uv.x() << ", " << uv.y()
+            << "), disparity " << cl.x() - cr.x() << " vs " << 6.0 << "\n";
 }
 
 TEST_F(RenderTest, GroundTruthDepthOfAWallIsItsDistance) {
@@ -122,8 +128,10 @@ TEST_F(RenderTest, GroundTruthDepthOfAWallIsItsDistance) {
   Mesh wall;
   wall.name = "wall";
   const float x = 20.f;
-  wall.vertices = {{x, -50, -30, -1, 0, 0, 0, 0}, {x, 50, -30, -1, 0, 0, 1, 0},
-                   {x, 50, 30, -1, 0, 0, 1, 1},   {x, -50, 30, -1, 0, 0, 0, 1}};
+  wall.vertices = {{x, -50, -30, -1, 0, 0, 0, 0},
+                   {x, 50, -30, -1, 0, 0, 1, 0},
+                   {x, 50, 30, -1, 0, 0, 1, 1},
+                   {x, -50, 30, -1, 0, 0, 0, 1}};
   wall.indices = {0, 1, 2, 0, 2, 3};
   s.meshes.push_back(wall);
   renderer_->upload(s);

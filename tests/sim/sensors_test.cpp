@@ -7,11 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
-#include <optional>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -79,10 +79,11 @@ TEST(SensorOptions, DefaultsAreValidAndRoundTripThroughYaml) {
 
 TEST(SensorOptions, ImuPresetSetsTheNoiseFieldsAndLaterKeysOverride) {
   // The in-class defaults are the mpu9250 preset, field for field.
-  EXPECT_EQ(yaml::to_yaml(ImuOptions{}), yaml::to_yaml(ImuOptions::preset_defaults(ImuPreset::kMpu9250)));
+  EXPECT_EQ(yaml::to_yaml(ImuOptions{}),
+            yaml::to_yaml(ImuOptions::preset_defaults(ImuPreset::kMpu9250)));
   const ImuOptions mpu;
-  EXPECT_DOUBLE_EQ(mpu.gyro_noise_density_rad_s_sqrt_hz, 0.01 * kDeg);        // datasheet
-  EXPECT_DOUBLE_EQ(mpu.accel_noise_density_m_s2_sqrt_hz, 300e-6 * kG);        // datasheet
+  EXPECT_DOUBLE_EQ(mpu.gyro_noise_density_rad_s_sqrt_hz, 0.01 * kDeg);  // datasheet
+  EXPECT_DOUBLE_EQ(mpu.accel_noise_density_m_s2_sqrt_hz, 300e-6 * kG);  // datasheet
   SensorOptions o;
   ASSERT_EQ(read_error("imu: {preset: adis16448, rate_hz: 200}\n", &o), "");
   EXPECT_DOUBLE_EQ(o.imu.gyro_noise_density_rad_s_sqrt_hz, 1.6968e-4);  // EuRoC sensor.yaml
@@ -135,8 +136,7 @@ TEST(SensorOptions, SimulatorsRejectBadOptionsBuiltInCode) {
   EXPECT_NE(e.find("sensors.imu.gyro_noise_density_rad_s_sqrt_hz: got -1, expected a value >= 0"),
             std::string::npos)
       << e;
-  EXPECT_NE(e.find("sensors.imu.rate_hz: got 0, expected a value in [1, 10000]"),
-            std::string::npos)
+  EXPECT_NE(e.find("sensors.imu.rate_hz: got 0, expected a value in [1, 10000]"), std::string::npos)
       << e;
   EXPECT_NE(e.find("sensors.imu.mount.position_frd_m[0]: got nan, expected a finite number"),
             std::string::npos)
@@ -215,7 +215,8 @@ TEST(ImuErrors, EachNoiseSourceHasItsOwnStream) {
   auto gyro_run = [](const ImuOptions& o) {
     ImuSimulator imu(o, RngStreams(42));
     std::vector<std::optional<ImuSample>> out;
-    for (int k = 0; k < 200; ++k) out.push_back(imu.measure(pose(0, 0, 0, Vec3::Zero(), TimeNs{k} * 5'000'000)));
+    for (int k = 0; k < 200; ++k)
+      out.push_back(imu.measure(pose(0, 0, 0, Vec3::Zero(), TimeNs{k} * 5'000'000)));
     return out;
   };
   ImuOptions a = ImuOptions::preset_defaults(ImuPreset::kAdis16448);
@@ -262,9 +263,10 @@ TEST(CompassSensor, CleanCompassReportsTrueHeadingAtAnyTilt) {
     // The field in the sensor frame is the Earth's, rotated: written out here.
     const double h = 49000 * std::cos(66 * kDeg);
     const Vec3 m_W(h * std::cos(7.5 * kDeg), h * std::sin(7.5 * kDeg), 49000 * std::sin(66 * kDeg));
-    const Mat3 R = (Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
-                    Eigen::AngleAxisd(roll, Vec3::UnitX()))
-                       .toRotationMatrix();
+    const Mat3 R =
+        (Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
+         Eigen::AngleAxisd(roll, Vec3::UnitX()))
+            .toRotationMatrix();
     EXPECT_LT((s->field_S_nt - R.transpose() * m_W).norm(), 1e-8);
   }
 }

@@ -20,15 +20,16 @@ struct SimRun {
   MotionSummary summary;
 };
 
-SimRun run(const VesselModel& model, const Environment& env, const VesselState& init, double seconds,
-        const VesselInputs& inputs = {}, Guidance* guidance = nullptr) {
+SimRun run(const VesselModel& model, const Environment& env, const VesselState& init,
+           double seconds, const VesselInputs& inputs = {}, Guidance* guidance = nullptr) {
   SimRun r;
   MotionOptions mo;
   mo.physics_rate_hz = model.options().physics_rate_hz;
   mo.max_duration_s = seconds;
   mo.fixed_inputs = inputs;
-  r.summary = simulate(model, env, guidance, init, mo, {},
-                       [&](const BodySample& b) { r.samples.push_back(b); }, nullptr);
+  r.summary = simulate(
+      model, env, guidance, init, mo, {}, [&](const BodySample& b) { r.samples.push_back(b); },
+      nullptr);
   return r;
 }
 
@@ -174,7 +175,8 @@ TEST(Vessel, EnergyIsConservedWithoutDampingOrForcing) {
   const double e1 = model.calm_water_energy(r.samples.back().state);
   ASSERT_GT(e0 - e_eq, 0.0);
   // Within 0.1 % of the energy put in above the floating equilibrium.
-  EXPECT_LT(std::abs(e1 - e0) / (e0 - e_eq), 1e-3) << "e_eq " << e_eq << " e0 " << e0 << " e1 " << e1;
+  EXPECT_LT(std::abs(e1 - e0) / (e0 - e_eq), 1e-3)
+      << "e_eq " << e_eq << " e0 " << e0 << " e1 " << e1;
 }
 
 TEST(Vessel, LosKeepsCrossTrackSmallOnStraightLegs) {
@@ -188,16 +190,15 @@ TEST(Vessel, LosKeepsCrossTrackSmallOnStraightLegs) {
   VesselState s = initial_state(model, Vec2(0, 1.5), 0.0);  // 1.5 m off the first leg
   std::vector<double> xte;
   MotionOptions mo;
-  MotionSummary sum = simulate(model, calm(), &g, s, mo, {},
-                               [&](const BodySample& b) {
-                                 const auto& p = b.state.p_W;
-                                 // Settled parts of the straight legs.
-                                 if (p.x() > 15 && p.x() < 38 && std::abs(p.y()) < 3)
-                                   xte.push_back(p.y());
-                                 if (p.y() > 12 && p.y() < 28 && std::abs(p.x() - 40) < 3)
-                                   xte.push_back(p.x() - 40);
-                               },
-                               nullptr);
+  MotionSummary sum = simulate(
+      model, calm(), &g, s, mo, {},
+      [&](const BodySample& b) {
+        const auto& p = b.state.p_W;
+        // Settled parts of the straight legs.
+        if (p.x() > 15 && p.x() < 38 && std::abs(p.y()) < 3) xte.push_back(p.y());
+        if (p.y() > 12 && p.y() < 28 && std::abs(p.x() - 40) < 3) xte.push_back(p.x() - 40);
+      },
+      nullptr);
   EXPECT_TRUE(sum.mission_completed);
   ASSERT_GT(xte.size(), 1000u);
   double worst = 0;
@@ -215,19 +216,20 @@ TEST(Vessel, TransectsMissionCrossesTheRiverFourTimes) {
   int crossings = 0;
   bool at_east = false;
   double max_abs_north = 0;
-  MotionSummary sum = simulate(model, calm(), &g, initial_state(model, start, 0.0), {}, {},
-                               [&](const BodySample& b) {
-                                 const double e = b.state.p_W.y();
-                                 if (!at_east && e > 6.5) {
-                                   at_east = true;
-                                   ++crossings;
-                                 } else if (at_east && e < -6.5) {
-                                   at_east = false;
-                                   ++crossings;
-                                 }
-                                 max_abs_north = std::max(max_abs_north, std::abs(b.state.p_W.x()));
-                               },
-                               nullptr);
+  MotionSummary sum = simulate(
+      model, calm(), &g, initial_state(model, start, 0.0), {}, {},
+      [&](const BodySample& b) {
+        const double e = b.state.p_W.y();
+        if (!at_east && e > 6.5) {
+          at_east = true;
+          ++crossings;
+        } else if (at_east && e < -6.5) {
+          at_east = false;
+          ++crossings;
+        }
+        max_abs_north = std::max(max_abs_north, std::abs(b.state.p_W.x()));
+      },
+      nullptr);
   EXPECT_TRUE(sum.mission_completed);
   EXPECT_EQ(crossings, 4);
   EXPECT_LT(max_abs_north, 0.5);
@@ -245,8 +247,9 @@ TEST(Vessel, SamplesBetweenPhysicsStepsLieOnTheTrajectory) {
   MotionOptions mo;
   mo.max_duration_s = 5;
   mo.fixed_inputs = in;
-  simulate(model, calm(), nullptr, s, mo, times, [&](const BodySample& b) { phys.push_back(b); },
-           [&](const BodySample& b) { cam.push_back(b); });
+  simulate(
+      model, calm(), nullptr, s, mo, times, [&](const BodySample& b) { phys.push_back(b); },
+      [&](const BodySample& b) { cam.push_back(b); });
   ASSERT_EQ(cam.size(), times.size());
   for (std::size_t k = 0; k < cam.size(); ++k) EXPECT_EQ(cam[k].t_ns, times[k]);
   // Against a run whose physics steps land on the sample times (rate 13 * 40 Hz):
@@ -271,12 +274,13 @@ TEST(Vessel, SameInputsSameBytes) {
   auto once = [&] {
     Guidance g(model, plan_mission(m, Vec2(0, 0), 0.0, {}), m);
     std::vector<double> bytes;
-    simulate(model, calm(), &g, initial_state(model, Vec2(0, 0), 0.0), {}, {},
-             [&](const BodySample& b) {
-               bytes.push_back(b.state.p_W.x());
-               bytes.push_back(b.state.q_W_B.w());
-             },
-             nullptr);
+    simulate(
+        model, calm(), &g, initial_state(model, Vec2(0, 0), 0.0), {}, {},
+        [&](const BodySample& b) {
+          bytes.push_back(b.state.p_W.x());
+          bytes.push_back(b.state.q_W_B.w());
+        },
+        nullptr);
     return bytes;
   };
   const auto a = once(), b = once();

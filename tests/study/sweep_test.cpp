@@ -21,9 +21,9 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "core/process.hpp"
 #include "core/rng.hpp"
 #include "core/yaml_io.hpp"
-#include "core/process.hpp"
 #include "gate/gate.hpp"
 #include "pipeline/scenario.hpp"
 #include "study/sweep_merge.hpp"
@@ -116,7 +116,8 @@ axes:
   EXPECT_EQ(param(plan.jobs[1], "water.waves.airy.wavelength_m"), "0.132");
   EXPECT_EQ(param(plan.jobs[2], "water.waves.airy.wavelength_m"), "0.059");
   // The fixed overrides are part of the base scenario of every job.
-  const pipeline::Scenario sc = pipeline::parse_scenario(plan.scenario_yaml, "scenario.yaml", kSweeps);
+  const pipeline::Scenario sc =
+      pipeline::parse_scenario(plan.scenario_yaml, "scenario.yaml", kSweeps);
   EXPECT_EQ(sc.water.waves.model, sim::WaveModel::kAiry);
   EXPECT_EQ(sc.water.waves.water_depth_m, 0.6);
 }
@@ -245,7 +246,8 @@ axes:
     EXPECT_EQ(a.jobs[k].hash.size(), 16u);
     hashes.insert(a.jobs[k].hash);
     // What the hash covers: every parameter of the job's resolved scenario.
-    const pipeline::Scenario sc = pipeline::parse_scenario(a.scenario_yaml, "x", kSweeps, a.jobs[k].overrides);
+    const pipeline::Scenario sc =
+        pipeline::parse_scenario(a.scenario_yaml, "x", kSweeps, a.jobs[k].overrides);
     EXPECT_EQ(a.jobs[k].hash, fnv1a64_hex(yaml::to_yaml(sc, false)));
   }
   EXPECT_EQ(hashes.size(), 4u);  // parameters or seed differ in every pair of jobs

@@ -46,12 +46,12 @@ namespace {
 // Runs `command` with its output in two temporary files, read back and removed.
 CommandResult run_with_logs(const std::string& command) {
   static int counter = 0;
-  const std::string stem = "driftlab_cmd_" + std::to_string(::getpid()) + "_" +
-                           std::to_string(counter++);
+  const std::string stem =
+      "driftlab_cmd_" + std::to_string(::getpid()) + "_" + std::to_string(counter++);
   const fs::path out_log = fs::temp_directory_path() / (stem + ".out");
   const fs::path err_log = fs::temp_directory_path() / (stem + ".err");
-  const std::string line = command + " > " + shell_quote(out_log.string()) + " 2> " +
-                           shell_quote(err_log.string());
+  const std::string line =
+      command + " > " + shell_quote(out_log.string()) + " 2> " + shell_quote(err_log.string());
   const int status = std::system(line.c_str());
   CommandResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

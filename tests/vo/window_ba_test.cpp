@@ -87,8 +87,7 @@ TEST(WindowBaOptionsTest, DefaultIsThePapersFrameToFrame) {
 
 TEST(WindowBaOptionsTest, ValidationAndYaml) {
   SparseVoOptions o = window_ba_options(1);
-  EXPECT_NE(yaml::validate(o).find("window_frames: got 1"), std::string::npos)
-      << yaml::validate(o);
+  EXPECT_NE(yaml::validate(o).find("window_frames: got 1"), std::string::npos) << yaml::validate(o);
   o.window_frames = 21;
   EXPECT_NE(yaml::validate(o).find("window_frames: got 21"), std::string::npos);
   EXPECT_THROW((void)SparseStereoOdometry(test::rig_640x480(), o, Rng(1)), UserError);
@@ -103,9 +102,8 @@ TEST(WindowBaOptionsTest, ValidationAndYaml) {
   SparseVoOptions target;
   yaml::read_into(yaml::load_string("refine: none\n", "t"), {"t", false}, &target);
   EXPECT_EQ(target.refine, SparseRefine::kNone);
-  EXPECT_THROW(
-      yaml::read_into(yaml::load_string("refine: ceres\n", "t"), {"t", false}, &target),
-      UserError);
+  EXPECT_THROW(yaml::read_into(yaml::load_string("refine: ceres\n", "t"), {"t", false}, &target),
+               UserError);
   EXPECT_THROW(
       yaml::read_into(yaml::load_string("window_frames: 50\n", "t"), {"t", false}, &target),
       UserError);
@@ -117,10 +115,11 @@ TEST(WindowBaOptionsTest, ValidationAndYaml) {
 void expect_no_worse(const char* name, const test::Sequence& seq) {
   const RunError f2f = run(seq, SparseVoOptions{});
   const RunError ba = run(seq, window_ba_options());
-  std::printf("[ %s ] after %d frames: frame-to-frame %.3f mm %.5f deg, "
-              "window_ba %.3f mm %.5f deg\n",
-              name, kFrames - 1, 1e3 * f2f.translation_m, f2f.rotation_rad * 180 / std::numbers::pi,
-              1e3 * ba.translation_m, ba.rotation_rad * 180 / std::numbers::pi);
+  std::printf(
+      "[ %s ] after %d frames: frame-to-frame %.3f mm %.5f deg, "
+      "window_ba %.3f mm %.5f deg\n",
+      name, kFrames - 1, 1e3 * f2f.translation_m, f2f.rotation_rad * 180 / std::numbers::pi,
+      1e3 * ba.translation_m, ba.rotation_rad * 180 / std::numbers::pi);
   EXPECT_TRUE(ba.all_finite);
   EXPECT_TRUE(f2f.all_finite);
   EXPECT_EQ(ba.valid, kFrames - 1);
@@ -143,9 +142,10 @@ TEST(WindowBaTest, StraightAccumulatedErrorNoWorseThanFrameToFrame) {
 TEST(WindowBaTest, YawAccumulatedErrorStaysWithinBounds) {
   const RunError f2f = run(yaw(), SparseVoOptions{});
   const RunError ba = run(yaw(), window_ba_options());
-  std::printf("[ yaw ] after %d frames: frame-to-frame %.3f mm %.5f deg, window_ba %.3f mm %.5f deg\n",
-              kFrames - 1, 1e3 * f2f.translation_m, f2f.rotation_rad * 180 / std::numbers::pi,
-              1e3 * ba.translation_m, ba.rotation_rad * 180 / std::numbers::pi);
+  std::printf(
+      "[ yaw ] after %d frames: frame-to-frame %.3f mm %.5f deg, window_ba %.3f mm %.5f deg\n",
+      kFrames - 1, 1e3 * f2f.translation_m, f2f.rotation_rad * 180 / std::numbers::pi,
+      1e3 * ba.translation_m, ba.rotation_rad * 180 / std::numbers::pi);
   EXPECT_TRUE(ba.all_finite);
   EXPECT_EQ(ba.valid, kFrames - 1);
   EXPECT_LT(ba.translation_m, 0.010);

@@ -5,8 +5,8 @@
 #include <memory>
 #include <utility>
 
-#include "core/stopwatch.hpp"
 #include "core/error.hpp"
+#include "core/stopwatch.hpp"
 #include "vo/dense/disparity.hpp"
 #include "vo/dense/photometric.hpp"
 

@@ -8,8 +8,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
-#include "core/stopwatch.hpp"
 #include "core/error.hpp"
+#include "core/stopwatch.hpp"
 #include "vo/pnp/pnp_features.hpp"
 #include "vo/pnp/pnp_subpixel.hpp"
 

@@ -54,8 +54,8 @@ struct SparseVoOptions {
   // estimated 3x too short). Lucas-Kanade on the image intensities, started at the SAD
   // positions, removes the locking.
   bool lk_refinement = true;
-  int lk_window_px = 11;          // ours: the descriptor's window
-  double lk_max_shift_px = 1.0;   // ours: farther than this from the SAD match is another point
+  int lk_window_px = 11;         // ours: the descriptor's window
+  double lk_max_shift_px = 1.0;  // ours: farther than this from the SAD match is another point
 
   // --- bucketing ------------------------------------------------------------------------------
   int bucket_width_px = 50;         // paper: 50x50 pixel windows
@@ -126,8 +126,7 @@ struct SparseVoOptions {
       "Then refine the final matches by Lucas-Kanade tracking of the current left patch into "
       "the other three images (OpenCV calcOpticalFlowPyrLK, one level), which does not lock "
       "to integer pixels (ours, not in the paper)");
-    a("lk_window_px", lk_window_px, "Lucas-Kanade window side [px], odd",
-      yaml::in_range(5, 31));
+    a("lk_window_px", lk_window_px, "Lucas-Kanade window side [px], odd", yaml::in_range(5, 31));
     a.require(lk_window_px % 2 == 1, "lk_window_px", "an odd number");
     a("lk_max_shift_px", lk_max_shift_px,
       "A match whose Lucas-Kanade position is farther than this from its SAD position is "

@@ -7,8 +7,8 @@
 
 #include <opencv2/video/tracking.hpp>
 
-#include "core/stopwatch.hpp"
 #include "core/error.hpp"
+#include "core/stopwatch.hpp"
 #include "vo/sparse/circle_matcher.hpp"
 #include "vo/sparse/features.hpp"
 #include "vo/sparse/stereo_motion.hpp"

@@ -206,9 +206,9 @@ bool WindowBundleAdjuster::solve(Result* result) {
   int residuals = 0;
   for (Track& track : tracks_) {
     for (const Observation& o : track.obs) {
-      auto* cost = new ceres::AutoDiffCostFunction<StereoReprojection, 4, 6, 3>(
-          new StereoReprojection{cam.fx, cam.fy, cam.cx, cam.cy, rig_.baseline_m, o.u_l, o.v_l,
-                                 o.u_r});
+      auto* cost =
+          new ceres::AutoDiffCostFunction<StereoReprojection, 4, 6, 3>(new StereoReprojection{
+              cam.fx, cam.fy, cam.cx, cam.cy, rig_.baseline_m, o.u_l, o.v_l, o.u_r});
       problem.AddResidualBlock(cost, &ceres_->loss, frames_[frame_index(o.frame)].pose.data(),
                                track.p.data());
       ++residuals;

@@ -47,11 +47,11 @@ class WindowBundleAdjuster {
   void reset();
 
   struct Result {
-    bool ok = false;   ///< false: the refinement failed; the window was reset
-    SE3 T_prev_curr;   ///< refined motion (the input one when !ok)
-    int frames = 0;    ///< frames in the window after this call
-    int tracks = 0;    ///< tracks (points) in the problem
-    int residuals = 0; ///< stereo observations in the problem
+    bool ok = false;    ///< false: the refinement failed; the window was reset
+    SE3 T_prev_curr;    ///< refined motion (the input one when !ok)
+    int frames = 0;     ///< frames in the window after this call
+    int tracks = 0;     ///< tracks (points) in the problem
+    int residuals = 0;  ///< stereo observations in the problem
   };
 
   /// Adds the frame of a successful frame-to-frame estimate: `circles` are its matches with the
