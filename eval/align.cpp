@@ -209,4 +209,78 @@ SimilarityTransform compute_alignment(Alignment method, const std::vector<Vec3>&
   return {};
 }
 
+namespace {
+
+// Unit principal axis (largest eigenvalue of the scatter) and the eigenvalues, decreasing.
+struct Principal {
+  Vec3 axis = Vec3::UnitX();
+  Vec3 eigenvalues = Vec3::Zero();  // of the mean scatter (1/n) sum p p^T [m^2]
+};
+
+Principal principal(const Centred& c) {
+  Mat3 C = Mat3::Zero();
+  for (const Vec3& p : c.points) C += p * p.transpose();
+  C /= static_cast<double>(c.points.size());
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(C);
+  DRIFTLAB_DEMAND_MSG(eig.info() == Eigen::Success, "alignment: eigen-decomposition failed");
+  Principal out;
+  out.axis = eig.eigenvectors().col(2);
+  out.eigenvalues = Vec3(eig.eigenvalues()(2), eig.eigenvalues()(1), eig.eigenvalues()(0));
+  return out;
+}
+
+double rms_residual(const SimilarityTransform& T, const std::vector<Vec3>& est,
+                    const std::vector<Vec3>& gt) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < est.size(); ++i) sum += (gt[i] - T.apply(est[i])).squaredNorm();
+  return std::sqrt(sum / static_cast<double>(est.size()));
+}
+
+// The observable part of a rigid fit on a (nearly) collinear track: the smallest rotation taking
+// the estimate's principal axis onto the truth's, then scale (sim3) and translation.
+SimilarityTransform axis_alignment(const Centred& ce, const Centred& cg, const Vec3& gt_axis,
+                                   bool with_scale) {
+  Vec3 est_axis = principal(ce).axis;
+  double along = 0.0;  // the axes point the same way when the positions along them correlate
+  for (std::size_t i = 0; i < ce.points.size(); ++i)
+    along += est_axis.dot(ce.points[i]) * gt_axis.dot(cg.points[i]);
+  if (along < 0.0) est_axis = -est_axis;
+  SimilarityTransform T;
+  T.R = Quat::FromTwoVectors(est_axis, gt_axis).toRotationMatrix();
+  if (with_scale) {
+    double num = 0.0;
+    for (std::size_t i = 0; i < ce.points.size(); ++i) num += cg.points[i].dot(T.R * ce.points[i]);
+    T.scale = num / (ce.variance * static_cast<double>(ce.points.size()));
+  }
+  T.t = cg.mean - T.scale * (T.R * ce.mean);
+  return T;
+}
+
+}  // namespace
+
+AlignmentFit fit_alignment(Alignment method, const std::vector<Vec3>& est,
+                           const std::vector<Vec3>& gt, int first_n) {
+  AlignmentFit fit{compute_alignment(method, est, gt, first_n), {}};
+  if (method == Alignment::kNone || method == Alignment::kPosYaw) return fit;
+  const std::size_t n =
+      first_n > 0 ? std::min(est.size(), static_cast<std::size_t>(first_n)) : est.size();
+  const std::vector<Vec3> e(est.begin(), est.begin() + static_cast<std::ptrdiff_t>(n));
+  const std::vector<Vec3> g(gt.begin(), gt.begin() + static_cast<std::ptrdiff_t>(n));
+  const Centred ce = centre(e);
+  const Centred cg = centre(g);
+  const Principal pg = principal(cg);
+  // RMS distance of the truth from its principal axis: the lever arm of a turn about the axis.
+  const double across = std::sqrt(std::max(0.0, pg.eigenvalues(1) + pg.eigenvalues(2)));
+  const double residual = rms_residual(fit.transform, e, g);
+  const bool collinear = across <= 1e-9 * std::sqrt(pg.eigenvalues(0));
+  if (!collinear && across > kMinAxisSpreadToResidual * residual) return fit;
+  fit.transform = axis_alignment(ce, cg, pg.axis, method == Alignment::kSim3);
+  fit.warning = fmt::format(
+      "{} alignment: the ground-truth track is nearly straight ({:.3g} m RMS off its axis, "
+      "against a fit residual of {:.3g} m RMS), so the rotation about the track's axis is "
+      "unobservable; aligned the axis direction{} and the position only",
+      yaml::enum_name(method), across, residual, method == Alignment::kSim3 ? ", the scale" : "");
+  return fit;
+}
+
 }  // namespace driftlab::eval

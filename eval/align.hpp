@@ -12,6 +12,7 @@
 // covariance rank" when fewer than 2 singular values exceed machine epsilon.)
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "core/se3.hpp"
@@ -53,5 +54,26 @@ SimilarityTransform align_pos_yaw(const std::vector<Vec3>& est, const std::vecto
 /// at the points. Throws UserError for first_n < 0.
 SimilarityTransform compute_alignment(Alignment method, const std::vector<Vec3>& est,
                                       const std::vector<Vec3>& gt, int first_n = 0);
+
+/// An alignment as fitted, with what the geometry left unobservable.
+struct AlignmentFit {
+  SimilarityTransform transform;
+  std::string warning;  ///< empty when every degree of freedom was observable
+};
+
+/// compute_alignment that refuses to invent a rotation. A rigid fit (horn, se3, sim3) determines
+/// the rotation about the ground-truth track's principal axis only through the track's spread
+/// across that axis; on a straight or back-and-forth track that spread is smaller than the
+/// estimate's errors (or zero), and the fit turns the estimate about the axis to absorb them.
+/// When the RMS distance of the ground truth from its principal axis is below
+/// kMinAxisSpreadToResidual times the fit's RMS residual (or zero), the fit falls back to what is
+/// observable: the rotation taking the estimate's principal axis onto the truth's (no turn about
+/// it), the scale (sim3) and the translation, and says so in `warning`. posyaw and none have no
+/// such rotation and are returned as compute_alignment gives them.
+AlignmentFit fit_alignment(Alignment method, const std::vector<Vec3>& est,
+                           const std::vector<Vec3>& gt, int first_n = 0);
+
+/// The across-axis spread a rigid fit needs, in units of its RMS residual.
+inline constexpr double kMinAxisSpreadToResidual = 3.0;
 
 }  // namespace driftlab::eval

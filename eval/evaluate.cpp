@@ -93,8 +93,11 @@ Evaluation evaluate(const EvaluationInput& in) {
     e.warnings.push_back(fmt::format("{} of {} estimate poses have no ground truth within {} s",
                                      unpaired, in.est.size(), opt.association_tolerance_s));
 
-  // Absolute errors: after alignment (river paper: Horn's method [48]).
-  e.alignment = compute_alignment(opt.align, positions(est), positions(gt), opt.align_first_n);
+  // Absolute errors: after alignment (river paper: Horn's method [48]), never a rotation the
+  // geometry leaves unobservable.
+  AlignmentFit fit = fit_alignment(opt.align, positions(est), positions(gt), opt.align_first_n);
+  e.alignment = fit.transform;
+  if (!fit.warning.empty()) e.warnings.push_back(std::move(fit.warning));
   const std::vector<SE3> est_aligned = e.alignment.apply(est);
   e.ape = ape(gt, est_aligned);
   e.track = track_errors(gt, est_aligned);
@@ -112,8 +115,10 @@ Evaluation evaluate(const EvaluationInput& in) {
                                        sub.name, g.size(), sub.start_s, sub.end_s));
       continue;
     }
-    const auto S = compute_alignment(opt.align, positions(s), positions(g), 0);
-    e.subtracks.push_back({sub.name, track_errors(g, S.apply(s))});
+    AlignmentFit sub_fit = fit_alignment(opt.align, positions(s), positions(g), 0);
+    if (!sub_fit.warning.empty())
+      e.warnings.push_back(fmt::format("subtrack '{}': {}", sub.name, sub_fit.warning));
+    e.subtracks.push_back({sub.name, track_errors(g, sub_fit.transform.apply(s))});
   }
 
   // Relative errors need no alignment.
@@ -141,8 +146,11 @@ Evaluation evaluate(const EvaluationInput& in) {
                     path_length_m(gt), opt.section_length_m));
   regress(opt, &e);
 
-  // Basin paper table: planar states of the camera, truth vs aligned estimate.
-  e.basin = basin_table(planar_states(t, gt, true), planar_states(t, est_aligned, true));
+  // Basin paper table: planar states of the camera, truth vs aligned estimate; the heading of
+  // the estimate as it came, since a fit of positions says nothing about it.
+  PlanarStates est_states = planar_states(t, est_aligned, true);
+  est_states.heading_rad = planar_states(t, est, true).heading_rad;
+  e.basin = basin_table(planar_states(t, gt, true), est_states);
   return e;
 }
 
