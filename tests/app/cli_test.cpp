@@ -27,17 +27,6 @@ const fs::path kCli = fs::path(DRIFTLAB_BINARY_DIR) / "bin" / "driftlab";
 
 std::string read_text(const fs::path& p) { return slurp(p); }
 
-// Each bad scenario states, in "# expect:" comment lines, what its message must contain.
-std::vector<std::string> expectations(const fs::path& file) {
-  std::vector<std::string> out;
-  std::ifstream in(file);
-  std::string line;
-  const std::string tag = "# expect: ";
-  while (std::getline(in, line))
-    if (line.rfind(tag, 0) == 0) out.push_back(line.substr(tag.size()));
-  return out;
-}
-
 std::vector<fs::path> bad_scenarios() {
   std::vector<fs::path> files;
   for (const auto& e : fs::directory_iterator(kSource / "tests/data/bad_scenarios"))
@@ -52,7 +41,7 @@ class BadScenario : public ::testing::TestWithParam<fs::path> {};
 
 TEST_P(BadScenario, FailsWithItsOwnClearMessage) {
   const fs::path file = GetParam();
-  const auto expected = expectations(file);
+  const auto expected = driftlab::test::expected_messages(file);
   ASSERT_FALSE(expected.empty()) << file << " has no '# expect:' line";
   const Result r = run_cli({"scenario", "check", file.string()});
   EXPECT_EQ(r.exit_code, 1) << r.output;

@@ -269,16 +269,6 @@ std::vector<fs::path> bad_sweeps() {
   return files;
 }
 
-std::vector<std::string> expectations(const fs::path& file) {
-  std::vector<std::string> out;
-  std::ifstream in(file);
-  std::string line;
-  const std::string tag = "# expect: ";
-  while (std::getline(in, line))
-    if (line.rfind(tag, 0) == 0) out.push_back(line.substr(tag.size()));
-  return out;
-}
-
 TEST(BadSweeps, CoverTheIssuesCases) {
   std::set<std::string> names;
   for (const auto& f : bad_sweeps()) names.insert(f.stem().string());
@@ -291,7 +281,7 @@ class BadSweep : public ::testing::TestWithParam<fs::path> {};
 
 TEST_P(BadSweep, FailsWithItsOwnClearMessage) {
   const fs::path file = GetParam();
-  const auto expected = expectations(file);
+  const auto expected = test::expected_messages(file);
   ASSERT_FALSE(expected.empty()) << file << " has no '# expect:' line";
   try {
     plan_sweep(load_sweep(file));

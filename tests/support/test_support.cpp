@@ -22,6 +22,15 @@ std::string slurp(const fs::path& path) {
   return ss.str();
 }
 
+std::vector<std::string> expected_messages(const fs::path& file) {
+  std::vector<std::string> out;
+  std::ifstream in(file);
+  const std::string tag = "# expect: ";
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(tag, 0) == 0) out.push_back(line.substr(tag.size()));
+  return out;
+}
+
 fs::path unused_temp_path(const std::string& name) {
   const fs::path p =
       fs::temp_directory_path() / ("driftlab_" + name + "_" + std::to_string(::getpid()));

@@ -17,6 +17,9 @@ std::filesystem::path cli_path();
 /// The whole file as bytes; "" when it cannot be read.
 std::string slurp(const std::filesystem::path& path);
 
+/// The "# expect: TEXT" comment lines of a bad input file: what its error message must contain.
+std::vector<std::string> expected_messages(const std::filesystem::path& file);
+
 /// A path under the temporary folder, unique to this process and `name`, that does not exist.
 std::filesystem::path unused_temp_path(const std::string& name);
 /// The same path, created as an empty folder.
