@@ -73,6 +73,7 @@ struct EvalArgs {
   std::string gt, est, format = "tum", align = "horn", covariates, out, name, rpe_unit = "frames";
   std::string regress = "v,h,f,d";
   double section_length_m = 6.5;
+  double length_sample_m = 0.5;
   double max_diff_s = 0.02;
   double rpe_delta = 1.0;
   int align_first_n = 0;
@@ -85,6 +86,7 @@ int eval_command(const EvalArgs& a) {
   // The flags map onto the scenario's `eval` section so the same checks apply.
   const std::vector<std::string> sets = {
       "section_length_m=" + fmt::format("{}", a.section_length_m),
+      "length_sample_m=" + fmt::format("{}", a.length_sample_m),
       "align=" + a.align,
       "align_first_n=" + std::to_string(a.align_first_n),
       "association_tolerance_s=" + fmt::format("{}", a.max_diff_s),
@@ -194,6 +196,11 @@ int main(int argc, char** argv) {
       ->add_option("--max-diff", ev.max_diff_s, "Largest stamp difference when pairing poses [s]")
       ->capture_default_str();
   eval_cmd->add_option("--section-length", ev.section_length_m, "Section length [m]")
+      ->capture_default_str();
+  eval_cmd
+      ->add_option("--length-sample", ev.length_sample_m,
+                   "Track lengths through one pose every this many metres of true travel "
+                   "(0 = every pose) [m]")
       ->capture_default_str();
   eval_cmd->add_option("--rpe-delta", ev.rpe_delta, "RPE step")->capture_default_str();
   eval_cmd->add_option("--rpe-unit", ev.rpe_unit, "RPE step unit: frames or meters")

@@ -100,7 +100,7 @@ Evaluation evaluate(const EvaluationInput& in) {
   if (!fit.warning.empty()) e.warnings.push_back(std::move(fit.warning));
   const std::vector<SE3> est_aligned = e.alignment.apply(est);
   e.ape = ape(gt, est_aligned);
-  e.track = track_errors(gt, est_aligned);
+  e.track = track_errors(gt, est_aligned, opt.length_sample_m);
   for (const auto& sub : opt.subtracks) {
     std::vector<SE3> g, s;
     for (std::size_t k = 0; k < t.size(); ++k) {
@@ -118,7 +118,8 @@ Evaluation evaluate(const EvaluationInput& in) {
     AlignmentFit sub_fit = fit_alignment(opt.align, positions(s), positions(g), 0);
     if (!sub_fit.warning.empty())
       e.warnings.push_back(fmt::format("subtrack '{}': {}", sub.name, sub_fit.warning));
-    e.subtracks.push_back({sub.name, track_errors(g, sub_fit.transform.apply(s))});
+    e.subtracks.push_back(
+        {sub.name, track_errors(g, sub_fit.transform.apply(s), opt.length_sample_m)});
   }
 
   // Relative errors need no alignment.

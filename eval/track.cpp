@@ -14,7 +14,30 @@ double path_length_m(const std::vector<SE3>& poses) {
   return s;
 }
 
-TrackErrors track_errors(const std::vector<SE3>& gt, const std::vector<SE3>& est) {
+std::vector<std::size_t> length_sample_indices(const std::vector<SE3>& gt, double spacing_m) {
+  std::vector<std::size_t> at;
+  if (gt.empty()) return at;
+  at.push_back(0);
+  double travelled = 0;
+  for (std::size_t i = 1; i < gt.size(); ++i) {
+    travelled += (gt[i].translation() - gt[i - 1].translation()).norm();
+    if (travelled >= spacing_m || i + 1 == gt.size()) {
+      at.push_back(i);
+      travelled = 0;
+    }
+  }
+  return at;
+}
+
+double path_length_m(const std::vector<SE3>& poses, const std::vector<std::size_t>& indices) {
+  double s = 0;
+  for (std::size_t k = 1; k < indices.size(); ++k)
+    s += (poses[indices[k]].translation() - poses[indices[k - 1]].translation()).norm();
+  return s;
+}
+
+TrackErrors track_errors(const std::vector<SE3>& gt, const std::vector<SE3>& est,
+                         double length_sample_m) {
   DRIFTLAB_DEMAND(gt.size() == est.size());
   TrackErrors r;
   r.n = gt.size();
@@ -31,8 +54,9 @@ TrackErrors track_errors(const std::vector<SE3>& gt, const std::vector<SE3>& est
   r.max_3d_m = s3.max;
   r.rmse_2d_m = s2.rmse;
   r.max_2d_m = s2.max;
-  r.length_gt_m = path_length_m(gt);
-  r.length_est_m = path_length_m(est);
+  const std::vector<std::size_t> at = length_sample_indices(gt, length_sample_m);
+  r.length_gt_m = path_length_m(gt, at);
+  r.length_est_m = path_length_m(est, at);
   if (r.length_gt_m > 0) {
     const double pct = 100.0 / r.length_gt_m;
     r.rmse_3d_pct = r.rmse_3d_m * pct;

@@ -16,6 +16,14 @@ namespace driftlab::eval {
 /// Path length of a sequence of positions [m].
 double path_length_m(const std::vector<SE3>& poses);
 
+/// Indices of the poses where the ground truth has moved at least `spacing_m` along its path
+/// since the previous index; the first and the last pose are always in. spacing_m = 0 takes
+/// every pose.
+std::vector<std::size_t> length_sample_indices(const std::vector<SE3>& gt, double spacing_m);
+
+/// Path length through the poses at `indices` only [m].
+double path_length_m(const std::vector<SE3>& poses, const std::vector<std::size_t>& indices);
+
 struct TrackErrors {
   std::size_t n = 0;
   double length_gt_m = 0;
@@ -27,8 +35,12 @@ struct TrackErrors {
 };
 
 /// Errors of aligned estimate positions against truth (same length, associated).
-/// 2D is the horizontal (north, east) part in the world NED frame.
-TrackErrors track_errors(const std::vector<SE3>& gt, const std::vector<SE3>& est_aligned);
+/// 2D is the horizontal (north, east) part in the world NED frame. Both lengths are taken
+/// through the same poses, one every `length_sample_m` of ground-truth travel
+/// (length_sample_indices): summed frame by frame, an estimate's pose noise adds length that
+/// grows with the frame rate, not with any error of the track's shape or scale.
+TrackErrors track_errors(const std::vector<SE3>& gt, const std::vector<SE3>& est_aligned,
+                         double length_sample_m);
 
 /// Basin paper table (Kucic and Valcic 2020, Tables 2-3): per quantity, the
 /// summary of the error (estimate minus reference; heading wrapped), whose

@@ -223,6 +223,20 @@ TEST(CliEval, WritesMetricsSectionsAndTables) {
   EXPECT_EQ(j["sections"]["count"], 4);
   EXPECT_NEAR(j["sections"]["p_m_per_m"]["mean"].get<double>(), 0.02, 1e-12);
   EXPECT_NEAR(j["algorithms"]["est"]["sections"]["p_m_per_m"]["max"].get<double>(), 0.02, 1e-12);
+  // The 2 % scale error is the length error, whether sampled (default) or summed per pose.
+  EXPECT_NEAR(j["track"]["length_error_pct"].get<double>(), 2.0, 1e-9);
+  const Result every_pose =
+      run_cli({"eval", "--gt", (dir / "gt.tum").string(), "--est", (dir / "est.tum").string(),
+               "--align", "none", "--length-sample", "0", "--out", (dir / "out0").string()});
+  ASSERT_EQ(every_pose.exit_code, 0) << every_pose.output;
+  const auto j0 = nlohmann::json::parse(read_text(dir / "out0/metrics.json"));
+  EXPECT_NEAR(j0["track"]["length_error_pct"].get<double>(), 2.0, 1e-9);
+  const Result negative =
+      run_cli({"eval", "--gt", (dir / "gt.tum").string(), "--est", (dir / "est.tum").string(),
+               "--length-sample", "-1", "--out", (dir / "out1").string()});
+  EXPECT_NE(negative.exit_code, 0);
+  EXPECT_NE(negative.err.find("length_sample_m: got -1"), std::string::npos) << negative.err;
+  EXPECT_FALSE(fs::exists(dir / "out1"));
   fs::remove_all(dir);
 }
 
