@@ -1,0 +1,60 @@
+// The frames a run's VOs see, in order: render and camera effects (CameraStage) of every
+// delivered frame, on a thread of their own when the run may use more than one, so that frame
+// k+1 renders while frame k is matched (the pipelined frame loop of the performance issue).
+// The frames, and so every output byte, are the same whatever the thread count: the render
+// thread runs the same stage in the same order, and the consumer takes frames in order.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pipeline/camera_stage.hpp"
+#include "pipeline/scenario.hpp"
+#include "sim/render/scene_geometry.hpp"
+#include "sim/sensors/clock.hpp"
+
+namespace driftlab::pipeline {
+
+/// One delivered stereo pair and what the frames.csv row says about it.
+struct CapturedFrame {
+  std::size_t k = 0;         ///< index into the run's frame times
+  sim::StereoImages images;  ///< what the camera delivers (rectified, 8-bit)
+  double render_ms = 0;      ///< wall-clock time of rendering and camera effects
+  double exposure_ms = 0;    ///< the exposure this frame was taken with
+};
+
+/// What the renderer reports once it has run.
+struct RenderInfo {
+  std::string context;  ///< GL version and renderer
+  std::size_t triangles = 0;
+};
+
+class FrameSource {
+ public:
+  /// Renders `scene` at the camera poses of `truth` (one per frame time), skipping the frames
+  /// `stamps` marks dropped. threads >= 2: on a thread of its own, at most `queue_frames`
+  /// ahead of the consumer; 1: inside next(). `scene` and `truth` must outlive the source.
+  FrameSource(const Scenario& sc, const sim::SceneGeometry& scene,
+              const std::vector<FrameTruth>& truth, const std::vector<sim::SampleTime>& stamps,
+              int threads, std::size_t queue_frames = 4);
+  ~FrameSource();
+  FrameSource(const FrameSource&) = delete;
+  FrameSource& operator=(const FrameSource&) = delete;
+
+  /// The next delivered frame, or nothing after the last. Rethrows what the render thread threw.
+  std::optional<CapturedFrame> next();
+  /// Valid once next() has returned the first frame (or nothing).
+  const RenderInfo& info() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The threads a run uses: `requested`, or every core when it is 0.
+int run_threads(int requested);
+
+}  // namespace driftlab::pipeline
