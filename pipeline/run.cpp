@@ -18,6 +18,7 @@
 #include "fusion/ca_smoother.hpp"
 #include "pipeline/camera_stage.hpp"
 #include "pipeline/filter_stage.hpp"
+#include "pipeline/frame_source.hpp"
 #include "pipeline/progress.hpp"
 #include "pipeline/render_stage.hpp"
 #include "pipeline/sensor_stage.hpp"
@@ -150,7 +151,7 @@ struct Track {
   std::unique_ptr<FilterTrack> filter;  // NAME_ned_kf, NAME_ned_pf, NAME_eskf streams
   std::size_t source = 0;               // for a smoothed stream: the VO track it follows
   Trajectory estimate;
-  std::vector<vo::VoResult> results;
+  std::vector<vo::VoResult> results;  // per frame time; a dropped frame's is invalid
   double vo_ms = 0;
 };
 
@@ -159,6 +160,9 @@ std::unique_ptr<vo::StereoOdometry> make_vo(VoAlgorithm a, const StereoRig& rig,
   switch (a) {
     case VoAlgorithm::kSparse:
       return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse, rng.stream("vo.sparse"));
+    case VoAlgorithm::kSparseKf:
+      return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse_kf,
+                                                        rng.stream("vo.sparse_kf"));
     case VoAlgorithm::kPnp:
       return std::make_unique<vo::PnpStereoOdometry>(rig, p.pnp, rng.stream("vo.pnp"));
     case VoAlgorithm::kDense:
@@ -205,15 +209,15 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
                               RunSummary* summary, nlohmann::json* metrics) {
   const RngStreams rng(sc.seed);
   const StereoRig rig = rig_of(sc.sensors.camera);
-  // Stage: render (the scene built once, uploaded once).
-  sim::StereoRenderer renderer(rig, sc.render);
-  renderer.upload(scene);
-  renderer.set_waves(sim::wave_components(sc.water.waves, rng.stream("waves.phases")));
-  CameraStage camera(sc, &renderer, rng);
   // The camera's clock: stamps (offset, jitter) and dropped frames.
   const std::vector<sim::SampleTime> stamps =
       sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
   DRIFTLAB_DEMAND_MSG(stamps.size() >= camera_gt.size(), "camera clock: fewer stamps than frames");
+  // Stage: render and camera effects (the scene built once, uploaded once), on a thread of
+  // their own when the run has more than one.
+  const int threads = run_threads(sc.pipeline.threads);
+  FrameSource source(sc, scene, frame_truth, stamps, threads);
+  (*metrics)["timing"]["threads"] = threads;
 
   // Stages: VO and fusion. VO sees images and the rig only; the pipeline
   // anchors every estimate at the true first pose so that tracks overlay.
@@ -229,6 +233,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
     Track t;
     t.name = std::string(yaml::enum_name(a));
     t.vo = std::move(v);
+    t.results.resize(camera_gt.size());
+    for (auto& r : t.results) r.reason = "frame dropped";
     tracks.push_back(std::move(t));
   }
   const std::size_t n_vo = tracks.size();
@@ -254,29 +260,27 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   if (first < camera_gt.size())
     for (auto& t : tracks) t.estimate.push_back({stamps[first].t_stamp_ns, camera_gt[first].T_W_C});
   std::size_t dropped = 0;
+  for (std::size_t k = 0; k < camera_gt.size(); ++k) dropped += stamps[k].dropped ? 1 : 0;
 
   AtomicFile frames_csv(dir / "frames.csv");
   std::string header = "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms,exposure_ms";
   for (std::size_t i = 0; i < n_vo; ++i)
-    header += fmt::format(",{0}_valid,{0}_inliers,{0}_valid_depth_px,{0}_mean_depth_m,{0}_ms",
-                          tracks[i].name);
+    header += fmt::format(
+        ",{0}_valid,{0}_inliers,{0}_valid_depth_px,{0}_mean_depth_m,{0}_ref_frames,{0}_ms",
+        tracks[i].name);
   frames_csv.write(header + "\n");
   double render_s = 0;
   Progress progress(options.progress, "render+vo", camera_gt.size(), options.progress_tty);
   const std::size_t sample_frame = camera_gt.size() / 2;  // drawn with its matches (Fig. 3)
   std::filesystem::create_directories(dir / "plots");
-  for (std::size_t k = 0; k < camera_gt.size(); ++k) {
+  while (std::optional<CapturedFrame> captured = source.next()) {
+    const std::size_t k = captured->k;  // dropped frames never come: nothing rendered or seen
     progress.update(k);
-    if (stamps[k].dropped) {  // never delivered: nothing rendered, nothing seen
-      ++dropped;
-      continue;
-    }
     const TimeNs t = stamps[k].t_stamp_ns;  // what the camera's clock wrote
-    const Stopwatch t_render;
-    const double exposure_ms = camera.exposure_ms();  // this frame's (auto exposure)
-    const sim::StereoImages img = camera.capture(frame_truth[k]);
-    const double render_ms = t_render.ms();
+    const double render_ms = captured->render_ms;
+    const double exposure_ms = captured->exposure_ms;
     render_s += render_ms / 1000;
+    const sim::StereoImages& img = captured->images;
     vo::StereoFrame frame;
     frame.t_ns = t;
     frame.left = cv::Mat(img.left.height, img.left.width, CV_8UC1,
@@ -288,18 +292,19 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
                                   render_ms, yaml::format_double(exposure_ms));
     for (std::size_t i = 0; i < tracks.size(); ++i) {
       Track& tr = tracks[i];
-      const vo::VoResult r = tr.vo ? tr.vo->process(frame) : tracks[tr.source].results.back();
+      const vo::VoResult r = tr.vo ? tr.vo->process(frame) : tracks[tr.source].results[k];
       if (k == sample_frame && tr.vo && r.valid) {
         if (const auto* sparse = dynamic_cast<const vo::SparseStereoOdometry*>(tr.vo.get()))
           cv::imwrite((dir / "plots" / (tr.name + "_matches.png")).string(),
                       draw_matches(frame, sparse->last_matches()));
       }
       if (tr.vo) {
-        tr.results.push_back(r);
+        tr.results[k] = r;
         tr.vo_ms += r.times.total_ms;
-        row += fmt::format(",{},{},{},{},{:.3f}", r.valid ? 1 : 0, r.inliers, r.valid_depth_pixels,
-                           r.valid ? yaml::format_double(r.mean_inlier_depth_m) : "",
-                           r.times.total_ms);
+        row +=
+            fmt::format(",{},{},{},{},{},{:.3f}", r.valid ? 1 : 0, r.inliers, r.valid_depth_pixels,
+                        r.valid ? yaml::format_double(r.mean_inlier_depth_m) : "",
+                        r.reference_frames_back, r.times.total_ms);
       }
       if (k == first) {
         if (tr.smoother) tr.smoother->update(t, r);  // starts the clock
@@ -398,8 +403,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
                           {"lens_distortion", cam.lens_distortion.enabled},
                           {"clock_offset_ms", cam.clock.offset_ms}};
   (*metrics)["warnings"] = warnings;
-  (*metrics)["render"] = {{"context", renderer.context_description()},
-                          {"triangles", renderer.triangles()}};
+  (*metrics)["render"] = {{"context", source.info().context},
+                          {"triangles", source.info().triangles}};
   summary->render_pairs_per_s = (*metrics)["timing"]["render_pairs_per_s"];
 }
 

@@ -23,10 +23,18 @@
 
 namespace driftlab::pipeline {
 
-enum class VoAlgorithm { kSparse, kPnp, kDense };
+enum class VoAlgorithm { kSparse, kSparseKf, kPnp, kDense };
 constexpr auto enum_table(VoAlgorithm) {
-  return std::array{std::pair{VoAlgorithm::kSparse, "sparse"}, std::pair{VoAlgorithm::kPnp, "pnp"},
-                    std::pair{VoAlgorithm::kDense, "dense"}};
+  return std::array{std::pair{VoAlgorithm::kSparse, "sparse"},
+                    std::pair{VoAlgorithm::kSparseKf, "sparse_kf"},
+                    std::pair{VoAlgorithm::kPnp, "pnp"}, std::pair{VoAlgorithm::kDense, "dense"}};
+}
+
+/// The options of sparse_kf: the sparse VO's, keyframes on.
+inline vo::SparseVoOptions sparse_kf_defaults() {
+  vo::SparseVoOptions o;
+  o.keyframes = true;
+  return o;
 }
 
 enum class FusionAlgorithm { kCaSmoother, kNedKf, kNedPf, kEskf };
@@ -42,8 +50,10 @@ struct PipelineOptions {
   std::vector<VoAlgorithm> vo{VoAlgorithm::kSparse};
   std::vector<FusionAlgorithm> fusion{FusionAlgorithm::kCaSmoother};
   int max_frames = 0;
+  int threads = 0;
   // Options of each algorithm (used when it runs).
   vo::SparseVoOptions sparse;
+  vo::SparseVoOptions sparse_kf = sparse_kf_defaults();
   vo::PnpVoOptions pnp;
   vo::DenseVoOptions dense;
   fusion::CaSmootherOptions ca_smoother;
@@ -57,7 +67,15 @@ struct PipelineOptions {
     a("fusion", fusion, "Filters and smoothers to run on the VO output");
     a("max_frames", max_frames, "Stop after this many stereo frames (0 = whole mission)",
       yaml::non_negative());
+    a("threads", threads,
+      "Threads of the frame loop: 0 = every core; 1 = render and VO in turn; 2 or more = "
+      "rendering on a thread of its own, one frame ahead or more (more than 2 are not used yet). "
+      "The output bytes are the same whatever the count",
+      yaml::in_range(0, 256));
     a("sparse", sparse, "Options of the sparse VO (river paper Section 2.3.1)");
+    a("sparse_kf", sparse_kf,
+      "Options of sparse_kf: the sparse VO matching against keyframes (keyframes: true; ours, "
+      "beyond the paper)");
     a("pnp", pnp, "Options of the GFTT+PnP VO (basin paper Section 3.1)");
     a("dense", dense, "Options of the dense photometric VO (river paper Section 2.3.2)");
     a("ca_smoother", ca_smoother,

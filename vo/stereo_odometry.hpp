@@ -48,6 +48,10 @@ struct VoResult {
                                ///< (dense: of the pixels used; covariate d of the river paper)
   int valid_depth_pixels = 0;  ///< dense VO: pixels with a valid depth in the depth map the motion
                                ///< was estimated from (covariate f of the river paper); others: 0
+  int reference_frames_back = 1;  ///< how many frames before this one the frame was that the
+                                  ///< motion was measured from (1: the previous frame; more
+                                  ///< with keyframes); T_prev_curr is still relative to the
+                                  ///< previous frame
   VoStageTimes times;
 
   /// One line for logs: "valid, 212/240 inliers, depth 7.3 m, 3.1 ms" or the reason.

@@ -96,6 +96,54 @@ TEST(Run, SameSeedSameBytes) {
   fs::remove_all(b);
 }
 
+// frames.csv without its wall-clock columns (render_ms and each VO's _ms).
+std::string frames_without_timing(const fs::path& dir) {
+  std::istringstream in(slurp(dir / "frames.csv"));
+  std::string line, out;
+  std::vector<bool> keep;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::string cell;
+    std::istringstream row(line);
+    while (std::getline(row, cell, ',')) cells.push_back(cell);
+    if (keep.empty())
+      for (const auto& c : cells) keep.push_back(c.size() < 3 || c.substr(c.size() - 3) != "_ms");
+    for (std::size_t i = 0; i < cells.size(); ++i)
+      if (i < keep.size() && keep[i]) out += cells[i] + ",";
+    out += "\n";
+  }
+  return out;
+}
+
+TEST(Run, SameBytesWhateverTheThreadCount) {
+  // Rendering on a thread of its own (threads: 2) or in turn with the VOs (threads: 1), with
+  // dropped frames and a keyframe VO: the same estimates, tables and per-frame rows.
+  const fs::path a = temp_dir("threads1"), b = temp_dir("threads2");
+  Scenario sc = short_crossing(40);
+  sc.pipeline.vo = {VoAlgorithm::kSparse, VoAlgorithm::kSparseKf};
+  sc.sensors.camera.clock.drop_probability = 0.1;
+  sc.pipeline.threads = 1;
+  run_scenario(sc, a, {});
+  sc.pipeline.threads = 2;
+  run_scenario(sc, b, {});
+  for (const char* f :
+       {"estimates/sparse.tum", "estimates/sparse_ca.tum", "estimates/sparse_kf.tum",
+        "estimates/sparse_kf_ca.tum", "sections.csv", "plots/data/sparse.dat"})
+    EXPECT_EQ(slurp(a / f), slurp(b / f)) << f;
+  EXPECT_EQ(frames_without_timing(a), frames_without_timing(b));
+  auto metrics = [](const fs::path& d) {
+    auto j = nlohmann::json::parse(slurp(d / "metrics.json"));
+    j.erase("timing");
+    return j;
+  };
+  const auto ma = metrics(a);
+  EXPECT_EQ(ma.dump(), metrics(b).dump());
+  EXPECT_GT(ma["camera"]["frames_dropped"].get<int>(), 0);
+  EXPECT_NE(frames_without_timing(a).find("sparse_kf_ref_frames"), std::string::npos);
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
 TEST(Run, SensorsSampleAtTheirRatesFromTheSameGroundTruth) {
   const fs::path out = temp_dir("sensors");
   Scenario sc = short_crossing(27);  // 2 s at 13 Hz
@@ -153,34 +201,35 @@ TEST(Run, WholeDischargeMeasurementMission) {
 // 1 px (2 px is libviso2's setting for noisier real cameras). With the
 // defaults (no MSAA, 2 px) the same leg gives e'_p 0.22 and 0.32 m/m; with
 // these, 0.12-0.17 m/m over seeds 2013, 1 and 2 (README, end-to-end test).
-TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractWithSaneErrors) {
+TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
+  // The shipped river_crossing scenario (both sparse VOs, the smoother, every camera effect of
+  // the defaults) on a straight calm leg: only the mission and its length are changed.
   const fs::path out = temp_dir("e2e");
   Scenario sc = load_scenario(kSource / "scenarios/river_crossing.yaml");
   ASSERT_EQ(sc.water.waves.model, sim::WaveModel::kCalm);
+  ASSERT_EQ(sc.pipeline.vo,
+            (std::vector<VoAlgorithm>{VoAlgorithm::kSparse, VoAlgorithm::kSparseKf}));
   sc.mission.type = sim::MissionType::kStraight;
   sc.mission.speed_mps = 0.5;
   sc.pipeline.max_frames = 420;
-  sc.pipeline.vo = {VoAlgorithm::kSparse};
-  sc.pipeline.fusion = {FusionAlgorithm::kCaSmoother};
-  sc.render.msaa_samples = 4;
-  sc.pipeline.sparse.inlier_threshold_px = 1.0;
   const RunSummary sum = run_scenario(sc, out, {});
   ASSERT_EQ(sum.frames, 420u);
 
   // Every file of the contract, non-empty.
   for (const char* f :
        {"scenario.resolved.yaml", "groundtruth.tum", "body_groundtruth.csv", "imu.csv", "gps.csv",
-        "compass.csv", "estimates/sparse.tum", "estimates/sparse_ca.tum", "frames.csv",
-        "sections.csv", "metrics.json", "report.md", "report.html"})
+        "compass.csv", "estimates/sparse.tum", "estimates/sparse_ca.tum", "estimates/sparse_kf.tum",
+        "estimates/sparse_kf_ca.tum", "frames.csv", "sections.csv", "metrics.json", "report.md",
+        "report.html"})
     EXPECT_GT(fs::file_size(out / f), 0u) << f;
   // The resolved scenario reproduces the run's settings.
   const Scenario back = load_scenario(out / "scenario.resolved.yaml");
-  EXPECT_EQ(back.render.msaa_samples, 4);
   EXPECT_EQ(back.pipeline.max_frames, 420);
+  EXPECT_EQ(back.mission.type, sim::MissionType::kStraight);
 
   // Ground truth and estimates: one pose per frame, the same timestamps.
   const Trajectory gt = read_tum(out / "groundtruth.tum");
-  const Trajectory est = read_tum(out / "estimates/sparse.tum");
+  const Trajectory est = read_tum(out / "estimates/sparse_kf.tum");
   ASSERT_EQ(gt.size(), 420u);
   ASSERT_EQ(est.size(), 420u);
   double length = 0;
@@ -191,12 +240,12 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractWithSaneErrors) {
   // 420 frames at 13 Hz, 0.5 m/s: 419 / 13 * 0.5 = 16.1 m (+ the start-up).
   EXPECT_NEAR(length, 419.0 / 13.0 * 0.5, 1.0);
 
-  // frames.csv: a header and a row per frame, the VO's columns present.
+  // frames.csv: a header and a row per frame, the VOs' columns present.
   std::istringstream frames(slurp(out / "frames.csv"));
   std::string header, line;
   std::getline(frames, header);
-  for (const char* col :
-       {"t_ns", "render_ms", "sparse_valid", "sparse_inliers", "sparse_mean_depth_m"})
+  for (const char* col : {"t_ns", "render_ms", "sparse_valid", "sparse_inliers",
+                          "sparse_mean_depth_m", "sparse_kf_ref_frames"})
     EXPECT_NE(header.find(col), std::string::npos) << col;
   int rows = 0;
   while (std::getline(frames, line)) rows += line.empty() ? 0 : 1;
@@ -209,22 +258,29 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractWithSaneErrors) {
   EXPECT_NEAR(m["track"]["length_m"].get<double>(), length, 1e-9);
   EXPECT_GT(m["timing"]["render_pairs_per_s"].get<double>(), 0);
   EXPECT_GT(m["timing"]["total_s"].get<double>(), 0);
-  for (const char* algo : {"sparse", "sparse_ca"}) {
+  for (const char* algo : {"sparse", "sparse_ca", "sparse_kf", "sparse_kf_ca"}) {
     const auto& a = m["algorithms"][algo];
     for (const char* k : {"rmse_3d_m", "rmse_2d_m", "max_3d_m", "max_2d_m", "rmse_3d_pct"})
       EXPECT_TRUE(std::isfinite(a["track"][k].get<double>())) << algo << " " << k;
     EXPECT_EQ(a["sections"]["count"].get<int>(), 2) << algo;
   }
 
-  // Sane values: the VO tracked every frame after the first, and its
-  // section errors are finite and below 0.2 m/m (the acceptance bound).
-  const auto& sparse = m["algorithms"]["sparse"];
-  const double mean = sparse["sections"]["p_m_per_m"]["mean"].get<double>();
-  const double max = sparse["sections"]["p_m_per_m"]["max"].get<double>();
-  EXPECT_TRUE(std::isfinite(mean) && std::isfinite(max));
-  EXPECT_LT(mean, 0.2);
-  EXPECT_GT(mean, 0.0);
-  EXPECT_LT(sparse["track"]["rmse_3d_pct"].get<double>(), 10.0);
+  // Accuracy on frames from the real renderer, shipped defaults. sparse_kf: the twin-fidelity
+  // issue's acceptance (e'_p at most 0.05 m/m, length within 3 %); measured on 2026-11-24:
+  // e'_p 0.041 m/m, length +2.3 %, 3D RMSE 2.65 % of the track, so the bounds fail a 22-30 %
+  // regression of the VO or the renderer. sparse (the paper's frame-to-frame method) is far
+  // worse on these frames (0.27 m/m, length -22 %: the README says why); its bound is 30 %
+  // above that, a guard against getting worse still.
+  auto mean_ep = [&](const char* algo) {
+    return m["algorithms"][algo]["sections"]["p_m_per_m"]["mean"].get<double>();
+  };
+  const auto& kf = m["algorithms"]["sparse_kf"];
+  EXPECT_LT(mean_ep("sparse_kf"), 0.050);
+  EXPECT_GT(mean_ep("sparse_kf"), 0.0);
+  EXPECT_LT(std::abs(kf["track"]["length_error_pct"].get<double>()), 3.0);
+  EXPECT_LT(kf["track"]["rmse_3d_pct"].get<double>(), 3.45);
+  EXPECT_LT(mean_ep("sparse"), 0.35);
+  EXPECT_GT(mean_ep("sparse"), 0.0);
   std::istringstream sections(slurp(out / "sections.csv"));
   std::getline(sections, header);
   int sparse_rows = 0;

@@ -38,7 +38,11 @@ TEST(Scenario, LoadsTheDemoScenario) {
   // 4 crossings of 13.5 m: the river paper's 54 m discharge measurement.
   EXPECT_DOUBLE_EQ(s.mission.crossings * s.mission.crossing_width_m, 54.0);
   EXPECT_DOUBLE_EQ(s.sensors.camera.baseline_m, 0.12);
-  EXPECT_EQ(s.pipeline.vo, std::vector<VoAlgorithm>{VoAlgorithm::kSparse});
+  // The paper's frame-to-frame method and the keyframe variant.
+  EXPECT_EQ(s.pipeline.vo,
+            (std::vector<VoAlgorithm>{VoAlgorithm::kSparse, VoAlgorithm::kSparseKf}));
+  EXPECT_FALSE(s.pipeline.sparse.keyframes);
+  EXPECT_TRUE(s.pipeline.sparse_kf.keyframes);
   EXPECT_DOUBLE_EQ(s.eval.section_length_m, 6.5);
 }
 

@@ -16,7 +16,8 @@ inline void append_result_bytes(const VoResult& r, std::vector<double>* bytes) {
   const auto& q = r.T_prev_curr.quaternion().coeffs();
   const auto& t = r.T_prev_curr.translation();
   bytes->insert(bytes->end(), {q[0], q[1], q[2], q[3], t[0], t[1], t[2], r.mean_inlier_depth_m,
-                               static_cast<double>(r.matches), static_cast<double>(r.inliers)});
+                               static_cast<double>(r.matches), static_cast<double>(r.inliers),
+                               static_cast<double>(r.reference_frames_back)});
 }
 
 /// `run(vo)` returns the bytes of a whole sequence processed by `vo`.

@@ -539,5 +539,135 @@ TEST(SparseVoTest, MotionBeyondTheSearchRadiusIsInvalidNotWrong) {
   }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Keyframes (sparse_kf)
+
+// A slow straight run: 2 cm per frame, sub-pixel to a few pixels of flow per frame.
+const test::Sequence& slow_640() {
+  static const test::Sequence s = test::make_sequence(
+      test::river_bank_scene_640(), test::rig_640x480(), test::straight_poses(10, 0.02));
+  return s;
+}
+
+std::vector<int> reference_frames(SparseStereoOdometry& vo, const test::Sequence& seq,
+                                  SE3* T_first_last) {
+  std::vector<int> refs;
+  SE3 T;
+  for (std::size_t k = 0; k < seq.frames.size(); ++k) {
+    const VoResult r = vo.process(seq.frames[k]);
+    if (k == 0) continue;
+    EXPECT_TRUE(r.valid) << "frame " << k << ": " << r.reason;
+    refs.push_back(r.reference_frames_back);
+    T = accumulate_pose(T, r);
+  }
+  *T_first_last = T;
+  return refs;
+}
+
+TEST(SparseKeyframeTest, OffByDefaultAndNamedSparseKfWhenOn) {
+  const test::Sequence& seq = slow_640();
+  SparseVoOptions o;
+  EXPECT_FALSE(o.keyframes);  // the paper's frame-to-frame method
+  SparseStereoOdometry paper(seq.rig, o, Rng(7));
+  EXPECT_EQ(paper.name(), "sparse");
+  SE3 T;
+  EXPECT_EQ(reference_frames(paper, seq, &T), std::vector<int>(9, 1));
+  o.keyframes = true;
+  EXPECT_EQ(SparseStereoOdometry(seq.rig, o, Rng(7)).name(), "sparse_kf");
+}
+
+TEST(SparseKeyframeTest, KeyframeMovesAfterMaxFramesAndTheChainFollowsTheTruth) {
+  // Flow, inlier and scale limits out of reach: the reference moves every keyframe_max_frames
+  // frames, so the references are 1, 2, 3, 1, 2, 3, ... frames back, and Eq. (3) chained over the
+  // increments still lands on the true last pose (0.18 m ahead).
+  const test::Sequence& seq = slow_640();
+  SparseVoOptions o;
+  o.keyframes = true;
+  o.keyframe_min_flow_px = 1000;
+  o.keyframe_min_inliers = 0;
+  o.keyframe_max_scale_change = 1.0;
+  o.keyframe_max_frames = 3;
+  SparseStereoOdometry vo(seq.rig, o, Rng(7));
+  SE3 T;
+  EXPECT_EQ(reference_frames(vo, seq, &T), (std::vector<int>{1, 2, 3, 1, 2, 3, 1, 2, 3}));
+  const SE3 truth = seq.T_scene_cam.front().inverse() * seq.T_scene_cam.back();
+  const auto e = test::motion_error(T, truth);
+  EXPECT_LT(e.translation_m, 2e-3);
+  EXPECT_LT(e.rotation_rad, 0.05 * kDeg);
+}
+
+TEST(SparseKeyframeTest, KeyframeMovesOnceTheMedianFlowReachesTheThreshold) {
+  // The same run with the flow rule alone: the reference stays while the median inlier flow
+  // from the keyframe is below the threshold. The flow grows with the distance from the
+  // keyframe, so a smaller threshold moves the keyframe at least as often, and a threshold
+  // below the flow of one frame gives the frame-to-frame method.
+  const test::Sequence& seq = slow_640();
+  auto refs = [&](double min_flow_px) {
+    SparseVoOptions o;
+    o.keyframes = true;
+    o.keyframe_min_flow_px = min_flow_px;
+    o.keyframe_min_inliers = 0;
+    o.keyframe_max_scale_change = 1.0;
+    o.keyframe_max_frames = 1000;
+    SparseStereoOdometry vo(seq.rig, o, Rng(7));
+    SE3 T;
+    return reference_frames(vo, seq, &T);
+  };
+  const auto max_of = [](const std::vector<int>& v) {
+    return *std::max_element(v.begin(), v.end());
+  };
+  EXPECT_EQ(refs(1e-3), std::vector<int>(9, 1));
+  EXPECT_EQ(refs(1000), (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 9}));
+  const std::vector<int> mid = refs(2.0);
+  EXPECT_GT(max_of(mid), 1);
+  EXPECT_LT(max_of(mid), 9);
+  EXPECT_LE(max_of(refs(1.0)), max_of(mid));
+}
+
+TEST(SparseKeyframeTest, KeyframeMovesOnceTheNearPointsScaleChanges) {
+  // Flow and frame limits out of reach, 2 cm per frame straight ahead: the reference moves
+  // once the run since it reaches the scale limit times the near inliers' depth, so a tighter
+  // limit moves it sooner, and a limit below one frame's run gives the frame-to-frame method.
+  const test::Sequence& seq = slow_640();
+  auto longest = [&](double max_scale_change) {
+    SparseVoOptions o;
+    o.keyframes = true;
+    o.keyframe_min_flow_px = 1000;
+    o.keyframe_min_inliers = 0;
+    o.keyframe_max_frames = 1000;
+    o.keyframe_max_scale_change = max_scale_change;
+    SparseStereoOdometry vo(seq.rig, o, Rng(7));
+    SE3 T;
+    const std::vector<int> refs = reference_frames(vo, seq, &T);
+    return *std::max_element(refs.begin(), refs.end());
+  };
+  EXPECT_EQ(longest(1e-4), 1);
+  EXPECT_EQ(longest(1.0), 9);
+  EXPECT_LE(longest(0.02), longest(0.05));
+  EXPECT_LT(longest(0.02), 9);
+}
+
+TEST(SparseKeyframeTest, DeterministicBytesAcrossInstancesAndResets) {
+  const test::Sequence& seq = slow_640();
+  auto run = [&](SparseStereoOdometry& vo) {
+    std::vector<double> bytes;
+    for (const StereoFrame& f : seq.frames) test::append_result_bytes(vo.process(f), &bytes);
+    return bytes;
+  };
+  SparseVoOptions o;
+  o.keyframes = true;
+  const Rng stream = RngStreams(2015).stream("vo.sparse_kf");
+  SparseStereoOdometry a(seq.rig, o, stream);
+  SparseStereoOdometry b(seq.rig, o, stream);
+  test::expect_same_bytes_across_instances_and_reset(a, b, run);
+}
+
+TEST(SparseKeyframeTest, KeyframesRefuseTheWindowAdjustment) {
+  SparseVoOptions o;
+  o.keyframes = true;
+  o.refine = SparseRefine::kWindowBa;
+  EXPECT_NE(yaml::validate(o).find("keyframes"), std::string::npos) << yaml::validate(o);
+}
+
 }  // namespace
 }  // namespace driftlab::vo

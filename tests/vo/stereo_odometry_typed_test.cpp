@@ -39,6 +39,14 @@ struct SparseFactory {
   }
 };
 
+struct SparseKfFactory {  // sparse_kf: keyframes with their shipped thresholds
+  static std::unique_ptr<StereoOdometry> make(const StereoRig& rig) {
+    SparseVoOptions o;
+    o.keyframes = true;
+    return std::make_unique<SparseStereoOdometry>(rig, o, RngStreams(2015).stream("vo.sparse_kf"));
+  }
+};
+
 struct PnpFactory {
   static std::unique_ptr<StereoOdometry> make(const StereoRig& rig) {
     return std::make_unique<PnpStereoOdometry>(rig, PnpVoOptions{},
@@ -53,7 +61,7 @@ struct DenseFactory {
   }
 };
 
-using Implementations = ::testing::Types<SparseFactory, PnpFactory, DenseFactory>;
+using Implementations = ::testing::Types<SparseFactory, SparseKfFactory, PnpFactory, DenseFactory>;
 
 // Rendering dominates the suite's run time: each sequence is rendered once per process.
 const test::Sequence& straight_640() {

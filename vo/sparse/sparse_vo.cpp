@@ -1,5 +1,6 @@
 #include "vo/sparse/sparse_vo.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <utility>
@@ -41,9 +42,14 @@ struct SparseStereoOdometry::Impl {
   sparse::CircleMatcher matcher;
   sparse::StereoMotionEstimator estimator;
   std::unique_ptr<sparse::WindowBundleAdjuster> window_ba;  // refine: window_ba only
-  // Current (1) and previous (0) pair; swapped, never copied, after each frame.
+  // Current (1) and reference (0) pair; swapped, never copied, when the reference moves (after
+  // each frame without keyframes).
   ImageFeatures l1, r1, l0, r0;
   bool has_previous = false;
+  // keyframes: the motion from the reference (keyframe) to the previous frame, and how many
+  // frames back the reference is from the current one.
+  SE3 T_key_prev;
+  int key_frames_back = 1;
   std::vector<CircleMatch> circles;
   std::vector<StereoPointMatch> points;
   std::vector<SparseMatchInfo> infos;
@@ -106,6 +112,33 @@ struct SparseStereoOdometry::Impl {
     circles.resize(kept);
   }
 
+  // keyframes: whether the reference stays for the next frame, given this frame's inliers
+  // against it and the motion from it (SparseVoOptions::keyframe_*).
+  bool keeps_keyframe(const std::vector<int>& inliers, const SE3& T_ref_curr) {
+    if (key_frames_back >= options.keyframe_max_frames) return false;
+    if (static_cast<int>(inliers.size()) < options.keyframe_min_inliers) return false;
+    std::vector<double> flow, depth;
+    flow.reserve(inliers.size());
+    depth.reserve(inliers.size());
+    for (const int i : inliers) {
+      const CircleMatch& c = circles[static_cast<std::size_t>(i)];
+      flow.push_back(std::hypot(c.u_lc - c.u_lp, c.v_lc - c.v_lp));
+      depth.push_back(rig.depth_from_disparity(c.u_lc - c.u_rc));  // Eq. (1)
+    }
+    auto quantile = [](std::vector<double>& v, double q) {
+      const auto at =
+          v.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+      std::nth_element(v.begin(), at, v.end());
+      return *at;
+    };
+    if (quantile(flow, 0.5) >= options.keyframe_min_flow_px) return false;
+    // Moving along the optical axis scales the near points' patches by about t_z / depth,
+    // which the fixed-size descriptors and LK windows do not follow.
+    const double near_depth_m = quantile(depth, 0.1);
+    return std::abs(T_ref_curr.translation().z()) <
+           options.keyframe_max_scale_change * near_depth_m;
+  }
+
   // The matches as Eq. (2) sees them: previous-frame points by Eq. (1), current observations.
   void to_points() {
     points.clear();
@@ -148,6 +181,8 @@ int SparseStereoOdometry::last_feature_count() const {
 
 void SparseStereoOdometry::reset() {
   impl_->has_previous = false;
+  impl_->T_key_prev = SE3();
+  impl_->key_frames_back = 1;
   impl_->rng = impl_->initial_rng;
   impl_->circles.clear();
   impl_->infos.clear();
@@ -171,17 +206,26 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   }
   result.times.detect_ms = ms_since(t_start);
 
-  // Whatever happens below, this pair is the next call's previous pair.
+  // Unless a keyframe stays the reference (keep_reference), this pair is the next call's
+  // reference pair, whatever happens below.
   struct Advance {
     Impl& s;
+    bool keep_reference = false;
     ~Advance() {
+      if (keep_reference) {
+        ++s.key_frames_back;
+        return;
+      }
       std::swap(s.l0, s.l1);
       std::swap(s.r0, s.r1);
       cv::swap(s.img_l0, s.img_l1);
       cv::swap(s.img_r0, s.img_r1);
       s.has_previous = true;
+      s.T_key_prev = SE3();
+      s.key_frames_back = 1;
     }
   } advance{s};
+  result.reference_frames_back = s.key_frames_back;
 
   auto finish = [&](std::string reason) {
     result.valid = false;
@@ -239,8 +283,11 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   for (const CircleMatch& c : s.circles)
     s.infos.push_back({c.u_lc, c.v_lc, c.u_rc, c.u_lp, c.v_lp, c.u_rp, false});
   if (!est.ok) return finish(est.failure);
-  SE3 T_prev_curr = est.T_curr_prev.inverse();
-  if (!detail::is_finite(T_prev_curr)) return finish("motion estimate not finite");
+  const SE3 T_ref_curr = est.T_curr_prev.inverse();
+  if (!detail::is_finite(T_ref_curr)) return finish("motion estimate not finite");
+  // With a keyframe as the reference, the increment since the previous frame; the chain of
+  // Eq. (3) then telescopes to keyframe pose * T_ref_curr.
+  SE3 T_prev_curr = s.T_key_prev.inverse() * T_ref_curr;
   if (s.window_ba) {  // falls back to the frame-to-frame estimate when the window solve fails
     t = SteadyClock::now();
     T_prev_curr = s.window_ba->add_frame(s.circles, *est.inliers, T_prev_curr).T_prev_curr;
@@ -258,6 +305,10 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   result.inliers = static_cast<int>(est.inliers->size());
   result.mean_inlier_depth_m = depth_sum / result.inliers;
   if (!std::isfinite(result.mean_inlier_depth_m)) return finish("mean depth not finite");
+  if (s.options.keyframes && s.keeps_keyframe(*est.inliers, T_ref_curr)) {
+    advance.keep_reference = true;
+    s.T_key_prev = T_ref_curr;
+  }
   result.times.total_ms = ms_since(t_start);
   return result;
 }

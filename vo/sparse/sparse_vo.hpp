@@ -41,7 +41,8 @@ class SparseStereoOdometry final : public StereoOdometry {
 
   VoResult process(const StereoFrame& frame) override;
   void reset() override;
-  std::string name() const override { return "sparse"; }
+  /// "sparse_kf" with keyframes, "sparse" (the river paper's frame-to-frame method) without.
+  std::string name() const override { return options().keyframes ? "sparse_kf" : "sparse"; }
 
   const SparseVoOptions& options() const;
   /// The bucketed circle matches handed to the estimator by the last process() call.
