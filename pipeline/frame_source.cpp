@@ -1,5 +1,6 @@
 #include "pipeline/frame_source.hpp"
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <exception>
@@ -19,6 +20,8 @@ int run_threads(int requested) {
   if (requested > 0) return requested;
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
+
+namespace {
 
 // The render stage proper: the renderer, its scene, and the camera effects, all created and
 // used on one thread (a GL context belongs to the thread that made it current).
@@ -44,6 +47,8 @@ struct Renderer {
   sim::StereoRenderer renderer;
   std::optional<CameraStage> camera;
 };
+
+}  // namespace
 
 struct FrameSource::Impl {
   const Scenario& sc;

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/csv.hpp"
 #include "core/rotation.hpp"
 #include "core/trajectory_io.hpp"
 #include "tests/support/test_support.hpp"
@@ -102,10 +103,7 @@ std::string frames_without_timing(const fs::path& dir) {
   std::string line, out;
   std::vector<bool> keep;
   while (std::getline(in, line)) {
-    std::vector<std::string> cells;
-    std::string cell;
-    std::istringstream row(line);
-    while (std::getline(row, cell, ',')) cells.push_back(cell);
+    const std::vector<std::string> cells = split_csv_line(line);
     if (keep.empty())
       for (const auto& c : cells) keep.push_back(c.size() < 3 || c.substr(c.size() - 3) != "_ms");
     for (std::size_t i = 0; i < cells.size(); ++i)
