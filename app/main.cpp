@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "app/cli_main.hpp"
+#include "app/dataset_commands.hpp"
 #include "app/gate_command.hpp"
 #include "app/study_commands.hpp"
 #include "core/atomic_file.hpp"
@@ -213,6 +214,9 @@ int main(int argc, char** argv) {
   eval_cmd->add_option("--out", ev.out, "Output folder (written atomically)")->required();
   eval_cmd->add_flag("--force", ev.force, "Replace an existing output folder");
 
+  // export, vo: datasets out and in.
+  driftlab::app::DatasetCommands dataset_commands(app);
+
   // sweep plan|run|status|merge|slurm-script, and run --manifest/--job/--shard.
   driftlab::app::StudyCommands study_commands(app);
   study_commands.add_run_options(run_cmd, run_scenario_opt, run_out_opt, &run_force);
@@ -224,6 +228,7 @@ int main(int argc, char** argv) {
     if (check_cmd->parsed()) return scenario_check(check_file, check_sets, check_quiet);
     if (schema_cmd->parsed()) return scenario_schema(schema_out);
     if (const auto rc = study_commands.dispatch()) return *rc;
+    if (const auto rc = dataset_commands.dispatch()) return *rc;
     if (const auto rc = gate_command.dispatch()) return *rc;
     if (run_cmd->parsed())
       return run_command(run_file, run_out, run_sets, run_seed, run_force, run_only_motion);

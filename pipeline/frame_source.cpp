@@ -32,12 +32,14 @@ struct Renderer {
     renderer.set_waves(sim::wave_components(sc.water.waves, rng.stream("waves.phases")));
     camera.emplace(sc, &renderer, rng);
   }
-  CapturedFrame capture(std::size_t k, const FrameTruth& truth) {
+  CapturedFrame capture(std::size_t k, const FrameTruth& truth, bool depth) {
     CapturedFrame f;
     f.k = k;
     const Stopwatch watch;
     f.exposure_ms = camera->exposure_ms();  // this frame's (auto exposure)
     f.images = camera->capture(truth);
+    if (depth)  // ground truth: the ideal pinhole depth at the centre of the exposure
+      f.images.depth_left = renderer.render(camera->T_W_C(truth), truth.t_s, true).depth_left;
     f.render_ms = watch.ms();
     return f;
   }
@@ -56,6 +58,7 @@ struct FrameSource::Impl {
   const std::vector<FrameTruth>& truth;
   const std::vector<sim::SampleTime>& stamps;
   std::size_t queue_frames;
+  bool depth;
   RenderInfo info;
   std::size_t next_k = 0;  // serial mode: the next frame index to look at
   std::unique_ptr<Renderer> serial;
@@ -69,8 +72,13 @@ struct FrameSource::Impl {
   std::exception_ptr error;
 
   Impl(const Scenario& sc_, const sim::SceneGeometry& scene_, const std::vector<FrameTruth>& t,
-       const std::vector<sim::SampleTime>& s, std::size_t q)
-      : sc(sc_), scene(scene_), truth(t), stamps(s), queue_frames(std::max<std::size_t>(1, q)) {}
+       const std::vector<sim::SampleTime>& s, std::size_t q, bool d)
+      : sc(sc_),
+        scene(scene_),
+        truth(t),
+        stamps(s),
+        queue_frames(std::max<std::size_t>(1, q)),
+        depth(d) {}
 
   std::size_t frames() const { return std::min(truth.size(), stamps.size()); }
 
@@ -89,7 +97,7 @@ struct FrameSource::Impl {
         info_ready = true;
       }
       for (std::size_t k = delivered_from(0); k < frames(); k = delivered_from(k + 1)) {
-        CapturedFrame f = r.capture(k, truth[k]);
+        CapturedFrame f = r.capture(k, truth[k], depth);
         std::unique_lock lock(mutex);
         changed.wait(lock, [&] { return stop || queue.size() < queue_frames; });
         if (stop) return;
@@ -126,15 +134,15 @@ struct FrameSource::Impl {
     next_k = delivered_from(next_k);
     if (next_k >= frames()) return std::nullopt;
     const std::size_t k = next_k++;
-    return serial->capture(k, truth[k]);
+    return serial->capture(k, truth[k], depth);
   }
 };
 
 FrameSource::FrameSource(const Scenario& sc, const sim::SceneGeometry& scene,
                          const std::vector<FrameTruth>& truth,
                          const std::vector<sim::SampleTime>& stamps, int threads,
-                         std::size_t queue_frames)
-    : impl_(std::make_unique<Impl>(sc, scene, truth, stamps, queue_frames)) {
+                         std::size_t queue_frames, bool depth)
+    : impl_(std::make_unique<Impl>(sc, scene, truth, stamps, queue_frames, depth)) {
   if (threads >= 2) impl_->worker = std::thread([this] { impl_->produce(); });
 }
 

@@ -37,9 +37,10 @@ class FrameSource {
   /// Renders `scene` at the camera poses of `truth` (one per frame time), skipping the frames
   /// `stamps` marks dropped. threads >= 2: on a thread of its own, at most `queue_frames`
   /// ahead of the consumer; 1: inside next(). `scene` and `truth` must outlive the source.
+  /// depth: each frame also carries the true depth of the left image (images.depth_left).
   FrameSource(const Scenario& sc, const sim::SceneGeometry& scene,
               const std::vector<FrameTruth>& truth, const std::vector<sim::SampleTime>& stamps,
-              int threads, std::size_t queue_frames = 4);
+              int threads, std::size_t queue_frames = 4, bool depth = false);
   ~FrameSource();
   FrameSource(const FrameSource&) = delete;
   FrameSource& operator=(const FrameSource&) = delete;

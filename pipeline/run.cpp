@@ -22,12 +22,11 @@
 #include "pipeline/progress.hpp"
 #include "pipeline/render_stage.hpp"
 #include "pipeline/sensor_stage.hpp"
+#include "pipeline/vo_stage.hpp"
 #include "report/run_report.hpp"
 #include "scenes/build_scene.hpp"
 #include "sim/render/renderer.hpp"
 #include "sim/waves/wave_field.hpp"
-#include "vo/dense/dense_vo.hpp"
-#include "vo/pnp/pnp_vo.hpp"
 #include "vo/sparse/sparse_vo.hpp"
 
 #include <opencv2/core.hpp>
@@ -155,22 +154,6 @@ struct Track {
   double vo_ms = 0;
 };
 
-std::unique_ptr<vo::StereoOdometry> make_vo(VoAlgorithm a, const StereoRig& rig,
-                                            const PipelineOptions& p, const RngStreams& rng) {
-  switch (a) {
-    case VoAlgorithm::kSparse:
-      return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse, rng.stream("vo.sparse"));
-    case VoAlgorithm::kSparseKf:
-      return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse_kf,
-                                                        rng.stream("vo.sparse_kf"));
-    case VoAlgorithm::kPnp:
-      return std::make_unique<vo::PnpStereoOdometry>(rig, p.pnp, rng.stream("vo.pnp"));
-    case VoAlgorithm::kDense:
-      return std::make_unique<vo::DenseStereoOdometry>(rig, p.dense, rng.stream("vo.dense"));
-  }
-  return nullptr;
-}
-
 // Fig. 3 of the river paper: the current left image above the right one, each match's
 // points joined across the pair, its flow from the previous frame drawn in the left image.
 cv::Mat draw_matches(const vo::StereoFrame& frame, std::span<const vo::SparseMatchInfo> matches) {
@@ -191,8 +174,7 @@ cv::Mat draw_matches(const vo::StereoFrame& frame, std::span<const vo::SparseMat
 
 }  // namespace
 
-// The scene around the camera track (river reach tiles covering its northings).
-static sim::SceneGeometry scene_for_track(const Scenario& sc, const Trajectory& camera_gt) {
+sim::SceneGeometry scene_for_track(const Scenario& sc, const Trajectory& camera_gt) {
   double north_min = camera_gt.front().T_W_C.translation().x(), north_max = north_min;
   for (const auto& p : camera_gt) {
     north_min = std::min(north_min, p.T_W_C.translation().x());
@@ -264,10 +246,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
 
   AtomicFile frames_csv(dir / "frames.csv");
   std::string header = "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms,exposure_ms";
-  for (std::size_t i = 0; i < n_vo; ++i)
-    header += fmt::format(
-        ",{0}_valid,{0}_inliers,{0}_valid_depth_px,{0}_mean_depth_m,{0}_ref_frames,{0}_ms",
-        tracks[i].name);
+  for (std::size_t i = 0; i < n_vo; ++i) header += vo_csv_header(tracks[i].name);
   frames_csv.write(header + "\n");
   double render_s = 0;
   Progress progress(options.progress, "render+vo", camera_gt.size(), options.progress_tty);
@@ -301,10 +280,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
       if (tr.vo) {
         tr.results[k] = r;
         tr.vo_ms += r.times.total_ms;
-        row +=
-            fmt::format(",{},{},{},{},{},{:.3f}", r.valid ? 1 : 0, r.inliers, r.valid_depth_pixels,
-                        r.valid ? yaml::format_double(r.mean_inlier_depth_m) : "",
-                        r.reference_frames_back, r.times.total_ms);
+        row += vo_csv_cells(r);
       }
       if (k == first) {
         if (tr.smoother) tr.smoother->update(t, r);  // starts the clock
@@ -408,6 +384,25 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   summary->render_pairs_per_s = (*metrics)["timing"]["render_pairs_per_s"];
 }
 
+MissionTruth simulate_mission(const Scenario& sc,
+                              const std::function<void(const sim::BodySample&)>& on_physics,
+                              SensorStage* sensors) {
+  const SE3 T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
+  MissionTruth truth;
+  const auto on_frame = [&](const sim::BodySample& b) {
+    truth.camera_gt.push_back({b.t_ns, b.state.T_W_B() * T_B_C});
+    Vec6 twist;
+    twist << b.state.v_B, b.state.w_B;
+    truth.frames.push_back({ns_to_seconds(b.t_ns), b.state.T_W_B(), twist});
+    truth.platform.push_back(euler_zyx_from_quat(b.state.q_W_B));
+  };
+  truth.motion = sensors ? simulate_scenario_motion(
+                               sc, on_physics, on_frame, sensors->sample_times(motion_end_s(sc)),
+                               [&](const sim::BodySample& b) { sensors->on_sample(b); })
+                         : simulate_scenario_motion(sc, on_physics, on_frame);
+  return truth;
+}
+
 RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir,
                         const RunOptions& options) {
   const auto t0 = SteadyClock::now();
@@ -417,25 +412,16 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
   write_file_atomic(dir.path() / "scenario.resolved.yaml", resolved_yaml(sc));
 
   // Stage: physics: ground truth at the physics rate and at each frame.
-  const SE3 T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
-  Trajectory camera_gt;
-  std::vector<FrameTruth> frame_truth;  // body pose and twist at each frame (the camera stage)
-  std::vector<EulerZYX> platform;       // body attitude at each frame (the IMU's, for covariate h)
   AtomicFile body(dir.path() / "body_groundtruth.csv");
   body.write(body_csv_header());
   const auto t_physics = SteadyClock::now();
   SensorStage sensors(sc, dir.path());
-  summary.motion = simulate_scenario_motion(
-      sc, [&](const sim::BodySample& b) { body.write(body_csv_row(b)); },
-      [&](const sim::BodySample& b) {
-        camera_gt.push_back({b.t_ns, b.state.T_W_B() * T_B_C});
-        Vec6 twist;
-        twist << b.state.v_B, b.state.w_B;
-        frame_truth.push_back({ns_to_seconds(b.t_ns), b.state.T_W_B(), twist});
-        platform.push_back(euler_zyx_from_quat(b.state.q_W_B));
-      },
-      sensors.sample_times(motion_end_s(sc)),
-      [&](const sim::BodySample& b) { sensors.on_sample(b); });
+  MissionTruth truth = simulate_mission(
+      sc, [&](const sim::BodySample& b) { body.write(body_csv_row(b)); }, &sensors);
+  summary.motion = truth.motion;
+  const Trajectory& camera_gt = truth.camera_gt;
+  const std::vector<FrameTruth>& frame_truth = truth.frames;
+  const std::vector<EulerZYX>& platform = truth.platform;
   summary.physics_s = seconds_since(t_physics);
   body.commit();
   write_tum(dir.path() / "groundtruth.tum", camera_gt);

@@ -10,8 +10,13 @@
 #include <string>
 #include <vector>
 
+#include "core/rotation.hpp"
 #include "core/se3.hpp"
+#include "core/trajectory_io.hpp"
+#include "pipeline/camera_stage.hpp"
 #include "pipeline/scenario.hpp"
+#include "pipeline/sensor_stage.hpp"
+#include "sim/render/scene_geometry.hpp"
 #include "sim/vessel/simulator.hpp"
 
 namespace driftlab::pipeline {
@@ -56,6 +61,23 @@ sim::MotionSummary simulate_scenario_motion(
 /// How long the scenario's motion runs [s]: mission.duration_s, cut to pipeline.max_frames
 /// camera frames; without either, the simulator's hard limit (the mission ends it earlier).
 double motion_end_s(const Scenario& scenario);
+
+/// The truth at the camera frames of a scenario's mission.
+struct MissionTruth {
+  sim::MotionSummary motion;
+  Trajectory camera_gt;            ///< left camera at each frame time
+  std::vector<FrameTruth> frames;  ///< body pose and twist at each frame (the camera stage)
+  std::vector<EulerZYX> platform;  ///< body attitude at each frame (covariate h)
+};
+
+/// The physics stage: the mission simulated, `on_physics` called at every physics step and
+/// `sensors` (may be null) fed at its sample times.
+MissionTruth simulate_mission(const Scenario& scenario,
+                              const std::function<void(const sim::BodySample&)>& on_physics,
+                              SensorStage* sensors);
+
+/// The scene around a camera track (river reach tiles covering its northings).
+sim::SceneGeometry scene_for_track(const Scenario& scenario, const Trajectory& camera_gt);
 
 /// Runs `scenario` into `out_dir` (temporary folder renamed at the end).
 RunSummary run_scenario(const Scenario& scenario, const std::filesystem::path& out_dir,

@@ -1,0 +1,171 @@
+#include "dataset/dataset.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.hpp"
+#include "core/file_io.hpp"
+#include "core/yaml_io.hpp"
+#include "dataset/dataset_detail.hpp"
+
+namespace driftlab::dataset {
+namespace fs = std::filesystem;
+
+DatasetFormat format_from_name(std::string_view name) {
+  std::string lower(name);
+  for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  if (lower == "kitti") return DatasetFormat::kKitti;
+  if (lower == "euroc") return DatasetFormat::kEuroc;
+  if (lower == "tum-rgbd") return DatasetFormat::kTumRgbd;
+  throw UserError(fmt::format(
+      "unknown dataset format: got '{}', expected one of: kitti, euroc, tum-rgbd", name));
+}
+
+std::string_view format_name(DatasetFormat format) {
+  switch (format) {
+    case DatasetFormat::kKitti:
+      return "kitti";
+    case DatasetFormat::kEuroc:
+      return "euroc";
+    case DatasetFormat::kTumRgbd:
+      return "tum-rgbd";
+  }
+  return "?";
+}
+
+std::unique_ptr<DatasetWriter> make_writer(DatasetFormat format, const fs::path& root,
+                                           const ExportCalibration& calibration) {
+  switch (format) {
+    case DatasetFormat::kKitti:
+      return detail::make_kitti_writer(root, calibration);
+    case DatasetFormat::kEuroc:
+      return detail::make_euroc_writer(root, calibration);
+    case DatasetFormat::kTumRgbd:
+      return detail::make_tum_rgbd_writer(root, calibration);
+  }
+  return nullptr;
+}
+
+StereoDataset read_dataset(const fs::path& root, DatasetFormat format, const ReadOptions& options) {
+  if (!fs::is_directory(root))
+    throw UserError(fmt::format("{}: no such dataset folder", root.string()));
+  switch (format) {
+    case DatasetFormat::kKitti:
+      return detail::read_kitti(root, options);
+    case DatasetFormat::kEuroc:
+      return detail::read_euroc(root);
+    case DatasetFormat::kTumRgbd:
+      throw UserError(
+          fmt::format("{}: a TUM RGB-D dataset has one camera; the stereo VOs read kitti or euroc",
+                      root.string()));
+  }
+  return {};
+}
+
+cv::Mat read_gray(const fs::path& path) {
+  if (!fs::is_regular_file(path)) throw UserError(path.string() + ": no such image");
+  const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  if (image.empty()) throw UserError(path.string() + ": cannot read the image");
+  if (image.depth() != CV_8U)
+    throw UserError(path.string() + ": expected an 8-bit image, got another depth");
+  if (image.channels() == 1) return image;
+  cv::Mat gray;
+  cv::cvtColor(image, gray, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  return gray;
+}
+
+std::optional<SE3> pose_at(const Trajectory& trajectory, TimeNs t_ns) {
+  if (trajectory.empty() || t_ns < trajectory.front().t_ns || t_ns > trajectory.back().t_ns)
+    return std::nullopt;
+  const auto after = std::lower_bound(trajectory.begin(), trajectory.end(), t_ns,
+                                      [](const StampedPose& p, TimeNs t) { return p.t_ns < t; });
+  if (after->t_ns == t_ns) return after->T_W_C;
+  const auto before = after - 1;
+  const double s =
+      static_cast<double>(t_ns - before->t_ns) / static_cast<double>(after->t_ns - before->t_ns);
+  return SE3::interpolate_decoupled(before->T_W_C, after->T_W_C, s);
+}
+
+namespace detail {
+
+std::vector<TextLine> data_lines(const fs::path& path, std::string_view what) {
+  const std::string text = read_text_file(path, what);
+  std::vector<TextLine> lines;
+  std::size_t pos = 0;
+  for (int number = 1; pos < text.size(); ++number) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(pos, end - pos);
+    pos = end + 1;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const auto first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    lines.push_back({number, std::move(line)});
+  }
+  return lines;
+}
+
+double parse_number(std::string_view token, const fs::path& path, int line,
+                    std::string_view field) {
+  while (!token.empty() && (token.front() == ' ' || token.front() == '\t')) token.remove_prefix(1);
+  while (!token.empty() && (token.back() == ' ' || token.back() == '\t')) token.remove_suffix(1);
+  double value = 0;
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (ec != std::errc() || end != token.data() + token.size() || !std::isfinite(value))
+    throw UserError(fmt::format("{}:{}: {}: got '{}', expected a finite number", path.string(),
+                                line, field, token.substr(0, 80)));
+  return value;
+}
+
+TimeNs parse_stamp_ns(std::string_view token, const fs::path& path, int line) {
+  while (!token.empty() && (token.front() == ' ' || token.front() == '\t')) token.remove_prefix(1);
+  while (!token.empty() && (token.back() == ' ' || token.back() == '\t')) token.remove_suffix(1);
+  TimeNs value = 0;
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (ec != std::errc() || end != token.data() + token.size() || value < 0)
+    throw UserError(
+        fmt::format("{}:{}: timestamp: got '{}', expected a non-negative integer in nanoseconds",
+                    path.string(), line, token.substr(0, 80)));
+  return value;
+}
+
+void write_png(const fs::path& path, const cv::Mat& image) {
+  if (!cv::imwrite(path.string(), image))
+    throw UserError(fmt::format("{}: cannot write the image", path.string()));
+}
+
+std::string matrix_text(const Eigen::MatrixXd& m, std::string_view sep) {
+  std::string out;
+  for (Eigen::Index r = 0; r < m.rows(); ++r)
+    for (Eigen::Index c = 0; c < m.cols(); ++c) {
+      if (!out.empty()) out += sep;
+      out += yaml::format_double(m(r, c));
+    }
+  return out;
+}
+
+Eigen::Matrix<double, 3, 4> matrix_3x4(const SE3& T) {
+  Eigen::Matrix<double, 3, 4> m;
+  m << T.rotation(), T.translation();
+  return m;
+}
+
+Eigen::Matrix4d matrix_4x4(const SE3& T) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topRows<3>() = matrix_3x4(T);
+  return m;
+}
+
+void move_file(const fs::path& from, const fs::path& to) {
+  fs::create_directories(to.parent_path());
+  fs::rename(from, to);
+}
+
+}  // namespace detail
+}  // namespace driftlab::dataset

@@ -1,0 +1,129 @@
+// Stereo datasets in the layouts other VO and VIO tools read: KITTI odometry, EuRoC/ASL
+// ("mav0") and TUM RGB-D. Writers turn a rendered sequence into one of them (`driftlab
+// export`); readers give back what a stereo VO needs from one, exported or recorded
+// (`driftlab vo`). Only images, calibration, time stamps, IMU and ground truth: no scenario,
+// no simulation, so that a real dataset and an exported one go through the same code.
+//
+// Conventions, per format (each export's info.yaml says the same in words):
+//  - KITTI odometry (devkit readme): sequences/NN/image_0|image_1/NNNNNN.png (left, right,
+//    8-bit gray, rectified), calib.txt with P0..P3 (3x4 row-major projection matrices of the
+//    rectified cameras, P1 = K [I | (-B, 0, 0)]), times.txt (seconds), poses/NN.txt (left
+//    camera pose in the first left camera's frame, 12 numbers per line, first the identity).
+//  - EuRoC/ASL (Burri et al. 2016): mav0/cam0|cam1/data/<t_ns>.png with data.csv and
+//    sensor.yaml (intrinsics fu fv cu cv, distortion, T_BS = the camera in the body frame,
+//    which is the IMU's), imu0/data.csv and sensor.yaml (Kalibr noise model),
+//    state_groundtruth_estimate0/data.csv (body pose in the world, velocity).
+//  - TUM RGB-D (Sturm et al. 2012): rgb/<t>.png, depth/<t>.png (16 bit, 5000 per metre, 0 =
+//    no depth), rgb.txt, depth.txt, groundtruth.txt (left camera pose, TUM format).
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/camera.hpp"
+#include "core/se3.hpp"
+#include "core/trajectory_io.hpp"
+
+namespace driftlab::dataset {
+
+enum class DatasetFormat { kKitti, kEuroc, kTumRgbd };
+
+/// "kitti", "euroc" or "tum-rgbd" (any case); UserError listing these otherwise.
+DatasetFormat format_from_name(std::string_view name);
+std::string_view format_name(DatasetFormat format);
+
+/// TUM RGB-D depth PNGs: 16-bit value = depth [m] * 5000; 0 means no depth.
+inline constexpr double kTumDepthScale = 5000.0;
+
+/// The IMU's Kalibr noise model (imu0/sensor.yaml of EuRoC).
+struct ImuNoiseModel {
+  double rate_hz = 0;                      ///< 0: no IMU in the dataset
+  double gyroscope_noise_density = 0;      ///< rad/s/sqrt(Hz)
+  double gyroscope_random_walk = 0;        ///< rad/s^2/sqrt(Hz)
+  double accelerometer_noise_density = 0;  ///< m/s^2/sqrt(Hz)
+  double accelerometer_random_walk = 0;    ///< m/s^3/sqrt(Hz)
+};
+
+/// What a writer needs besides the frames.
+struct ExportCalibration {
+  StereoRig rig;  ///< the rectified pair the images are in
+  SE3 T_S_C;      ///< left camera in the body frame (EuRoC: the IMU's)
+  double camera_rate_hz = 0;
+  ImuNoiseModel imu;
+  std::string sequence = "00";  ///< KITTI sequence number
+  std::string source;           ///< one line on where the data come from (info.yaml)
+};
+
+/// The body (IMU) frame's true state, for EuRoC's state_groundtruth_estimate0.
+struct BodyState {
+  TimeNs t_ns = 0;
+  SE3 T_W_S;
+  Vec3 v_W = Vec3::Zero();
+};
+
+/// Ground truth and the other sensors, handed to a writer once every frame is in.
+struct ExportTruth {
+  Trajectory camera;            ///< true left-camera pose of each added frame, in order
+  std::vector<BodyState> body;  ///< EuRoC only; may be empty
+  /// The other sensors' CSVs, already written (imu.csv in EuRoC's IMU layout, driftlab's own
+  /// gps.csv and compass.csv): each is moved into the dataset where its format keeps such
+  /// streams (EuRoC: mav0/imu0/data.csv, gps0/, compass0/; KITTI and TUM: sensors/).
+  std::vector<std::filesystem::path> sensor_csvs;
+};
+
+/// Writes one dataset into `root` (which must exist). Frames come in time order.
+class DatasetWriter {
+ public:
+  virtual ~DatasetWriter() = default;
+  /// left, right: 8-bit gray; depth_m: CV_32F metres (non-finite or <= 0: none), or empty.
+  virtual void add_frame(TimeNs t_stamp_ns, const cv::Mat& left, const cv::Mat& right,
+                         const cv::Mat& depth_m) = 0;
+  /// Ground truth, calibration and info.yaml. Call once, after the last frame.
+  virtual void finish(const ExportTruth& truth) = 0;
+  /// Whether add_frame() wants the depth image.
+  virtual bool wants_depth() const = 0;
+};
+
+std::unique_ptr<DatasetWriter> make_writer(DatasetFormat format, const std::filesystem::path& root,
+                                           const ExportCalibration& calibration);
+
+/// One stereo pair of a dataset: where its images are and when they were taken.
+struct DatasetFrame {
+  TimeNs t_ns = 0;
+  std::filesystem::path left, right;
+};
+
+/// What a stereo VO needs from a dataset, and the ground truth to judge it by.
+struct StereoDataset {
+  DatasetFormat format = DatasetFormat::kKitti;
+  std::filesystem::path root;
+  StereoRig rig;
+  std::vector<DatasetFrame> frames;
+  Trajectory camera_gt;  ///< left camera; empty when the dataset has none
+  std::vector<ImuSample> imu;
+  SE3 T_S_C;  ///< left camera in the body frame (identity where unknown)
+};
+
+struct ReadOptions {
+  std::string sequence = "00";  ///< KITTI: sequences/NN under the root
+};
+
+/// Reads a dataset's index, calibration and ground truth (not the images). Strict: a missing
+/// file, a malformed line or a pair that is not rectified throws UserError naming the file.
+StereoDataset read_dataset(const std::filesystem::path& root, DatasetFormat format,
+                           const ReadOptions& options = {});
+
+/// An 8-bit gray image (colour is converted); UserError naming the file when it cannot be read.
+cv::Mat read_gray(const std::filesystem::path& path);
+
+/// The pose of `trajectory` (sorted) at time t: interpolated between the neighbours
+/// (SE3::interpolate_decoupled), or nothing outside its time span.
+std::optional<SE3> pose_at(const Trajectory& trajectory, TimeNs t_ns);
+
+}  // namespace driftlab::dataset

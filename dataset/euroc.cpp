@@ -1,0 +1,264 @@
+// EuRoC/ASL layout (Burri et al., "The EuRoC micro aerial vehicle datasets", IJRR 2016; the
+// ASL dataset format): writer and reader.
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/file_io.hpp"
+#include "core/yaml_io.hpp"
+#include "dataset/dataset_detail.hpp"
+
+namespace driftlab::dataset::detail {
+namespace fs = std::filesystem;
+namespace {
+
+std::string t_bs_yaml(const SE3& T_B_S) {
+  return fmt::format("T_BS:\n  cols: 4\n  rows: 4\n  data: [{}]\n",
+                     matrix_text(matrix_4x4(T_B_S), ", "));
+}
+
+std::string camera_yaml(const ExportCalibration& cal, int index, const SE3& T_S_C) {
+  const PinholeCamera& c = cal.rig.camera;
+  return fmt::format(
+      "# General sensor definitions.\n"
+      "sensor_type: camera\n"
+      "comment: driftlab cam{} ({} camera of the rectified stereo pair)\n"
+      "# Sensor extrinsics wrt. the body-frame.\n{}"
+      "# Camera specific definitions.\n"
+      "rate_hz: {}\n"
+      "resolution: [{}, {}]\n"
+      "camera_model: pinhole\n"
+      "intrinsics: [{}, {}, {}, {}] #fu, fv, cu, cv\n"
+      "distortion_model: radial-tangential\n"
+      "distortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n",
+      index, index == 0 ? "left" : "right", t_bs_yaml(T_S_C),
+      yaml::format_double(cal.camera_rate_hz), c.width, c.height, yaml::format_double(c.fx),
+      yaml::format_double(c.fy), yaml::format_double(c.cx), yaml::format_double(c.cy));
+}
+
+std::string imu_yaml(const ImuNoiseModel& m) {
+  return fmt::format(
+      "# General sensor definitions.\n"
+      "sensor_type: imu\n"
+      "comment: driftlab imu0 (the scenario's sensors.imu)\n"
+      "# Sensor extrinsics wrt. the body-frame.\n{}"
+      "rate_hz: {}\n"
+      "# inertial sensor noise model parameters (static)\n"
+      "gyroscope_noise_density: {}     # [ rad / s / sqrt(Hz) ]   ( gyro \"white noise\" )\n"
+      "gyroscope_random_walk: {}       # [ rad / s^2 / sqrt(Hz) ] ( gyro bias diffusion )\n"
+      "accelerometer_noise_density: {} # [ m / s^2 / sqrt(Hz) ]   ( accel \"white noise\" )\n"
+      "accelerometer_random_walk: {}   # [ m / s^3 / sqrt(Hz) ].  ( accel bias diffusion )\n",
+      t_bs_yaml(SE3()), yaml::format_double(m.rate_hz),
+      yaml::format_double(m.gyroscope_noise_density), yaml::format_double(m.gyroscope_random_walk),
+      yaml::format_double(m.accelerometer_noise_density),
+      yaml::format_double(m.accelerometer_random_walk));
+}
+
+std::string info_yaml(const ExportCalibration& cal, std::size_t frames) {
+  return fmt::format(
+      "# driftlab export, EuRoC/ASL layout\n"
+      "format: euroc\n"
+      "source: \"{}\"\n"
+      "frames: {}\n"
+      "camera_rate_hz: {}\n"
+      "frames_and_units: \"body frame B = the IMU's (imu0 T_BS is the identity); world R = the "
+      "scenario's NED frame (x north, y east, z down: gravity is +z); cameras x right, y down, z "
+      "forward; time stamps in ns of the sensors' clocks\"\n"
+      "files:\n"
+      "  mav0/cam0/data/<t_ns>.png: left image, 8-bit gray, rectified (distortion zero)\n"
+      "  mav0/cam1/data/<t_ns>.png: right image of the same pair, baseline {} m\n"
+      "  mav0/camN/data.csv: '#timestamp [ns],filename'\n"
+      "  mav0/camN/sensor.yaml: intrinsics fu fv cu cv, resolution, T_BS = camera in the body "
+      "frame (4x4 row-major)\n"
+      "  mav0/imu0/data.csv: angular rate [rad/s] and specific force [m/s^2] in the IMU frame\n"
+      "  mav0/imu0/sensor.yaml: the IMU's Kalibr noise model\n"
+      "  mav0/state_groundtruth_estimate0/data.csv: true body pose in the world (p_RS_R, "
+      "q_RS), velocity v_RS_R, at most 200 Hz; no bias columns (the simulated biases are not "
+      "exported yet)\n"
+      "  mav0/gps0/data.csv, mav0/compass0/data.csv: driftlab's own GPS and compass CSVs\n"
+      "  scenario.resolved.yaml: the scenario that made this dataset\n",
+      cal.source, frames, yaml::format_double(cal.camera_rate_hz), cal.rig.baseline_m);
+}
+
+class EurocWriter final : public DatasetWriter {
+ public:
+  EurocWriter(const fs::path& root, const ExportCalibration& cal)
+      : root_(root), mav_(root / "mav0"), cal_(cal) {
+    fs::create_directories(mav_ / "cam0" / "data");
+    fs::create_directories(mav_ / "cam1" / "data");
+    index_ = "#timestamp [ns],filename\n";
+  }
+  void add_frame(TimeNs t, const cv::Mat& left, const cv::Mat& right, const cv::Mat&) override {
+    const std::string name = fmt::format("{}.png", t);
+    write_png(mav_ / "cam0" / "data" / name, left);
+    write_png(mav_ / "cam1" / "data" / name, right);
+    index_ += fmt::format("{},{}\n", t, name);
+    ++frames_;
+  }
+  bool wants_depth() const override { return false; }
+  void finish(const ExportTruth& truth) override {
+    const SE3 T_C0_C1(Mat3::Identity(), Vec3(cal_.rig.baseline_m, 0, 0));
+    for (int i = 0; i < 2; ++i) {
+      const fs::path cam = mav_ / fmt::format("cam{}", i);
+      write_file_atomic(cam / "data.csv", index_);
+      write_file_atomic(cam / "sensor.yaml",
+                        camera_yaml(cal_, i, i == 0 ? cal_.T_S_C : cal_.T_S_C * T_C0_C1));
+    }
+    Trajectory body;
+    std::vector<Vec3> velocities;
+    for (const BodyState& b : truth.body) {
+      body.push_back({b.t_ns, b.T_W_S});
+      velocities.push_back(b.v_W);
+    }
+    fs::create_directories(mav_ / "state_groundtruth_estimate0");
+    write_euroc_groundtruth(mav_ / "state_groundtruth_estimate0" / "data.csv", body, velocities);
+    for (const auto& csv : truth.sensor_csvs)
+      move_file(csv, mav_ / (csv.stem().string() + "0") / "data.csv");
+    if (fs::exists(mav_ / "imu0" / "data.csv"))
+      write_file_atomic(mav_ / "imu0" / "sensor.yaml", imu_yaml(cal_.imu));
+    write_file_atomic(root_ / "info.yaml", info_yaml(cal_, frames_));
+  }
+
+ private:
+  fs::path root_, mav_;
+  ExportCalibration cal_;
+  std::string index_;
+  std::size_t frames_ = 0;
+};
+
+// --- Reading.
+
+struct CameraYaml {
+  PinholeCamera camera;
+  std::vector<double> distortion;
+  SE3 T_B_C;
+};
+
+std::vector<double> yaml_numbers(const YAML::Node& root, const char* key, std::size_t count,
+                                 const fs::path& path) {
+  const YAML::Node node = root[key];
+  if (!node || !node.IsSequence() || (count && node.size() != count))
+    throw UserError(fmt::format("{}: {}: expected a list of {} numbers", path.string(), key,
+                                count ? std::to_string(count) : "some"));
+  std::vector<double> out;
+  for (const auto& v : node) {
+    try {
+      out.push_back(v.as<double>());
+    } catch (const YAML::Exception&) {
+      throw UserError(fmt::format("{}:{}: {}: got '{}', expected a number", path.string(),
+                                  v.Mark().line + 1, key, v.Scalar()));
+    }
+  }
+  return out;
+}
+
+CameraYaml read_camera_yaml(const fs::path& path) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(read_text_file(path, "EuRoC sensor.yaml"));
+  } catch (const YAML::Exception& e) {
+    throw UserError(fmt::format("{}:{}: {}", path.string(), e.mark.line + 1, e.msg));
+  }
+  CameraYaml c;
+  const auto k = yaml_numbers(root, "intrinsics", 4, path);
+  const auto res = yaml_numbers(root, "resolution", 2, path);
+  c.camera.fx = k[0];
+  c.camera.fy = k[1];
+  c.camera.cx = k[2];
+  c.camera.cy = k[3];
+  c.camera.width = static_cast<int>(res[0]);
+  c.camera.height = static_cast<int>(res[1]);
+  if (root["distortion_coefficients"])
+    c.distortion = yaml_numbers(root, "distortion_coefficients", 0, path);
+  const auto t = yaml_numbers(root["T_BS"] ? root["T_BS"] : YAML::Node(), "data", 16, path);
+  Mat3 R;
+  R << t[0], t[1], t[2], t[4], t[5], t[6], t[8], t[9], t[10];
+  const Eigen::JacobiSVD<Mat3> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  if ((R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() > 1e-3)
+    throw UserError(path.string() + ": T_BS: the rotation part is not a rotation");
+  c.T_B_C = SE3(Quat(Mat3(svd.matrixU() * svd.matrixV().transpose())), Vec3(t[3], t[7], t[11]));
+  return c;
+}
+
+std::vector<std::pair<TimeNs, std::string>> read_camera_index(const fs::path& path) {
+  std::vector<std::pair<TimeNs, std::string>> out;
+  for (const TextLine& line : data_lines(path, "EuRoC camera data.csv")) {
+    const auto comma = line.text.find(',');
+    if (comma == std::string::npos)
+      throw UserError(fmt::format("{}:{}: got '{}', expected 'timestamp,filename'", path.string(),
+                                  line.number, line.text.substr(0, 80)));
+    std::string file = line.text.substr(comma + 1);
+    while (!file.empty() && file.front() == ' ') file.erase(0, 1);
+    out.emplace_back(parse_stamp_ns(line.text.substr(0, comma), path, line.number), file);
+    if (out.size() > 1 && out.back().first <= out[out.size() - 2].first)
+      throw UserError(
+          fmt::format("{}:{}: timestamp: got {}, expected more than the line "
+                      "before's {}",
+                      path.string(), line.number, out.back().first, out[out.size() - 2].first));
+  }
+  return out;
+}
+
+// The pair must already be rectified: the VOs take a pinhole rig with a pure x baseline.
+StereoRig rectified_rig(const CameraYaml& c0, const CameraYaml& c1, const fs::path& cam1_yaml) {
+  const SE3 T_C0_C1 = c0.T_B_C.inverse() * c1.T_B_C;
+  const double baseline = T_C0_C1.translation().x();
+  bool rectified = baseline > 0 && std::abs(T_C0_C1.translation().y()) < 1e-6 * baseline &&
+                   std::abs(T_C0_C1.translation().z()) < 1e-6 * baseline &&
+                   (T_C0_C1.rotation() - Mat3::Identity()).cwiseAbs().maxCoeff() < 1e-9;
+  for (const auto* c : {&c0, &c1})
+    for (double d : c->distortion) rectified = rectified && d == 0;
+  const PinholeCamera &a = c0.camera, &b = c1.camera;
+  rectified = rectified && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy &&
+              a.width == b.width && a.height == b.height;
+  if (!rectified)
+    throw UserError(fmt::format(
+        "{}: cam0 and cam1 are not a rectified pair (expected equal pinhole intrinsics, zero "
+        "distortion and cam1 = cam0 moved along its x axis only); driftlab vo does not rectify "
+        "raw EuRoC images yet: rectify them first (e.g. cv::stereoRectify) and write the "
+        "rectified calibration",
+        cam1_yaml.string()));
+  StereoRig rig;
+  rig.camera = a;
+  rig.baseline_m = baseline;
+  return rig;
+}
+
+}  // namespace
+
+std::unique_ptr<DatasetWriter> make_euroc_writer(const fs::path& root,
+                                                 const ExportCalibration& calibration) {
+  return std::make_unique<EurocWriter>(root, calibration);
+}
+
+StereoDataset read_euroc(const fs::path& root) {
+  const fs::path mav = fs::is_directory(root / "mav0") ? root / "mav0" : root;
+  StereoDataset d;
+  d.format = DatasetFormat::kEuroc;
+  d.root = root;
+  const CameraYaml c0 = read_camera_yaml(mav / "cam0" / "sensor.yaml");
+  const CameraYaml c1 = read_camera_yaml(mav / "cam1" / "sensor.yaml");
+  d.rig = rectified_rig(c0, c1, mav / "cam1" / "sensor.yaml");
+  d.T_S_C = c0.T_B_C;
+  const auto left = read_camera_index(mav / "cam0" / "data.csv");
+  const auto right = read_camera_index(mav / "cam1" / "data.csv");
+  std::size_t j = 0;  // pairs: the stamps both cameras have
+  for (const auto& [t, file] : left) {
+    while (j < right.size() && right[j].first < t) ++j;
+    if (j < right.size() && right[j].first == t)
+      d.frames.push_back(
+          {t, mav / "cam0" / "data" / file, mav / "cam1" / "data" / right[j].second});
+  }
+  if (d.frames.empty())
+    throw UserError(
+        fmt::format("{}: no time stamp in both cam0/data.csv and cam1/data.csv", mav.string()));
+  const fs::path gt = mav / "state_groundtruth_estimate0" / "data.csv";
+  if (fs::exists(gt))
+    for (const StampedPose& p : read_euroc_groundtruth(gt))
+      d.camera_gt.push_back({p.t_ns, p.T_W_C * d.T_S_C});
+  if (fs::exists(mav / "imu0" / "data.csv")) d.imu = read_euroc_imu(mav / "imu0" / "data.csv");
+  return d;
+}
+
+}  // namespace driftlab::dataset::detail

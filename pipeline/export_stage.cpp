@@ -1,0 +1,126 @@
+#include "pipeline/export_stage.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "core/atomic_file.hpp"
+#include "core/stopwatch.hpp"
+#include "pipeline/frame_source.hpp"
+#include "pipeline/progress.hpp"
+#include "pipeline/render_stage.hpp"
+#include "pipeline/run.hpp"
+#include "pipeline/sensor_stage.hpp"
+#include "sim/sensors/clock.hpp"
+
+namespace driftlab::pipeline {
+namespace fs = std::filesystem;
+
+namespace {
+
+// The IMU's frame S in the body frame (the identity when there is no IMU).
+SE3 imu_T_B_S(const Scenario& sc) {
+  return sc.sensors.imu.enabled ? sim::SensorMount::from_options(sc.sensors.imu.mount).T_B_S()
+                                : SE3();
+}
+
+// EuRoC's ground truth rate is 200 Hz: every n-th physics step, at most that often.
+std::size_t body_decimation(const Scenario& sc) {
+  return std::max<std::size_t>(
+      1, static_cast<std::size_t>(std::lround(sc.vessel.physics_rate_hz / 200.0)));
+}
+
+cv::Mat view(const sim::GrayImage& img) {
+  return cv::Mat(img.height, img.width, CV_8UC1, const_cast<std::uint8_t*>(img.pixels.data()));
+}
+
+cv::Mat view(const sim::DepthImage& d) {
+  if (d.depth_m.empty()) return {};
+  return cv::Mat(d.height, d.width, CV_32FC1, const_cast<float*>(d.depth_m.data()));
+}
+
+}  // namespace
+
+std::string ExportSummary::brief() const {
+  return fmt::format(
+      "exported {} stereo pairs and {} IMU samples; render {:.1f} pairs/s; total "
+      "{:.2f} s",
+      frames, imu_samples, render_pairs_per_s, total_s);
+}
+
+dataset::ExportCalibration export_calibration(const Scenario& sc) {
+  dataset::ExportCalibration cal;
+  cal.rig = rig_of(sc.sensors.camera);
+  cal.T_S_C = imu_T_B_S(sc).inverse() * camera_mount_T_B_C(sc.sensors.camera.mount);
+  cal.camera_rate_hz = sc.sensors.camera.rate_hz;
+  const auto& imu = sc.sensors.imu;
+  if (imu.enabled)
+    cal.imu = {imu.rate_hz, imu.gyro_noise_density_rad_s_sqrt_hz,
+               imu.gyro_random_walk_rad_s2_sqrt_hz, imu.accel_noise_density_m_s2_sqrt_hz,
+               imu.accel_random_walk_m_s3_sqrt_hz};
+  cal.source = fmt::format("driftlab scenario '{}', seed {}", sc.name, sc.seed);
+  return cal;
+}
+
+ExportSummary export_dataset(const Scenario& sc, const fs::path& out_dir,
+                             const ExportOptions& options) {
+  const auto t0 = SteadyClock::now();
+  validate_scenario(sc, "scenario '" + sc.name + "'");
+  AtomicDirectory dir(out_dir, options.replace_existing);
+  write_file_atomic(dir.path() / "scenario.resolved.yaml", resolved_yaml(sc));
+  dataset::ExportCalibration cal = export_calibration(sc);
+  cal.sequence = options.sequence;
+  const auto writer = dataset::make_writer(options.format, dir.path(), cal);
+
+  // Physics and the other sensors (into a staging folder the writer empties).
+  const fs::path staging = dir.path() / ".sensors";
+  fs::create_directories(staging);
+  SensorStage sensors(sc, staging);
+  dataset::ExportTruth truth;
+  const SE3 T_B_S = imu_T_B_S(sc);
+  const std::size_t every = body_decimation(sc);
+  std::size_t step = 0;
+  const MissionTruth mission = simulate_mission(
+      sc,
+      [&](const sim::BodySample& b) {
+        if (step++ % every) return;
+        const Vec3 v_S_B = b.state.v_B + b.state.w_B.cross(T_B_S.translation());
+        truth.body.push_back(
+            {b.t_ns, b.state.T_W_B() * T_B_S, b.state.q_W_B.toRotationMatrix() * v_S_B});
+      },
+      &sensors);
+  if (mission.camera_gt.empty()) throw UserError("scenario '" + sc.name + "': no camera frames");
+  const sim::SceneGeometry scene = scene_for_track(sc, mission.camera_gt);
+  const SensorData sensor_data = sensors.finish(&scene);
+  for (const char* name : {"imu.csv", "gps.csv", "compass.csv"})
+    if (fs::exists(staging / name)) truth.sensor_csvs.push_back(staging / name);
+
+  // The frames, as a run's VOs see them.
+  const RngStreams rng(sc.seed);
+  const std::vector<sim::SampleTime> stamps =
+      sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
+  FrameSource source(sc, scene, mission.frames, stamps, run_threads(sc.pipeline.threads), 4,
+                     writer->wants_depth());
+  ExportSummary summary;
+  double render_s = 0;
+  Progress progress(options.progress, "export", mission.camera_gt.size(), options.progress_tty);
+  while (std::optional<CapturedFrame> f = source.next()) {
+    progress.update(f->k);
+    render_s += f->render_ms / 1000;
+    writer->add_frame(stamps[f->k].t_stamp_ns, view(f->images.left), view(f->images.right),
+                      view(f->images.depth_left));
+    truth.camera.push_back(mission.camera_gt[f->k]);
+    ++summary.frames;
+  }
+  progress.update(mission.camera_gt.size());
+  progress.finish();
+  writer->finish(truth);
+  fs::remove_all(staging);
+  dir.commit();
+  summary.imu_samples = sensor_data.imu.size();
+  summary.render_pairs_per_s = render_s > 0 ? static_cast<double>(summary.frames) / render_s : 0;
+  summary.total_s = seconds_since(t0);
+  return summary;
+}
+
+}  // namespace driftlab::pipeline

@@ -1,0 +1,39 @@
+#include "pipeline/vo_stage.hpp"
+
+#include <fmt/format.h>
+
+#include "core/yaml_io.hpp"
+#include "vo/dense/dense_vo.hpp"
+#include "vo/pnp/pnp_vo.hpp"
+#include "vo/sparse/sparse_vo.hpp"
+
+namespace driftlab::pipeline {
+
+std::unique_ptr<vo::StereoOdometry> make_vo(VoAlgorithm a, const StereoRig& rig,
+                                            const PipelineOptions& p, const RngStreams& rng) {
+  switch (a) {
+    case VoAlgorithm::kSparse:
+      return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse, rng.stream("vo.sparse"));
+    case VoAlgorithm::kSparseKf:
+      return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse_kf,
+                                                        rng.stream("vo.sparse_kf"));
+    case VoAlgorithm::kPnp:
+      return std::make_unique<vo::PnpStereoOdometry>(rig, p.pnp, rng.stream("vo.pnp"));
+    case VoAlgorithm::kDense:
+      return std::make_unique<vo::DenseStereoOdometry>(rig, p.dense, rng.stream("vo.dense"));
+  }
+  return nullptr;
+}
+
+std::string vo_csv_header(const std::string& name) {
+  return fmt::format(
+      ",{0}_valid,{0}_inliers,{0}_valid_depth_px,{0}_mean_depth_m,{0}_ref_frames,{0}_ms", name);
+}
+
+std::string vo_csv_cells(const vo::VoResult& r) {
+  return fmt::format(",{},{},{},{},{},{:.3f}", r.valid ? 1 : 0, r.inliers, r.valid_depth_pixels,
+                     r.valid ? yaml::format_double(r.mean_inlier_depth_m) : "",
+                     r.reference_frames_back, r.times.total_ms);
+}
+
+}  // namespace driftlab::pipeline

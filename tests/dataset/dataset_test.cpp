@@ -1,0 +1,264 @@
+// The dataset writers against each format's published description (KITTI odometry devkit,
+// EuRoC/ASL, TUM RGB-D file formats) and a round trip through our readers.
+#include "dataset/dataset.hpp"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/rotation.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace driftlab::dataset {
+namespace {
+
+namespace fs = std::filesystem;
+using test::slurp;
+
+ExportCalibration calibration() {
+  ExportCalibration cal;
+  cal.rig.camera.fx = 480;
+  cal.rig.camera.fy = 470;
+  cal.rig.camera.cx = 40.5;
+  cal.rig.camera.cy = 30.25;
+  cal.rig.camera.width = 80;
+  cal.rig.camera.height = 60;
+  cal.rig.baseline_m = 0.25;
+  cal.T_S_C = SE3(quat_from_euler_zyx({0.1, -0.2, 0.3}), Vec3(0.5, -0.1, 0.2));
+  cal.camera_rate_hz = 10;
+  cal.imu = {200, 1.7e-4, 2e-5, 2e-3, 3e-3};
+  cal.source = "test";
+  return cal;
+}
+
+// Three frames of random 8-bit images, a true trajectory and body states.
+struct Sequence {
+  std::vector<TimeNs> stamps{1'000'000'000, 1'100'000'123, 1'200'000'000};
+  std::vector<cv::Mat> left, right, depth;
+  ExportTruth truth;
+  Sequence() {
+    cv::RNG rng(7);
+    for (std::size_t i = 0; i < stamps.size(); ++i) {
+      cv::Mat l(60, 80, CV_8UC1), r(60, 80, CV_8UC1), d(60, 80, CV_32FC1);
+      rng.fill(l, cv::RNG::UNIFORM, 0, 256);
+      rng.fill(r, cv::RNG::UNIFORM, 0, 256);
+      rng.fill(d, cv::RNG::UNIFORM, 0.5, 20.0);
+      d.at<float>(0, 0) = std::numeric_limits<float>::infinity();  // sky: no depth
+      left.push_back(l);
+      right.push_back(r);
+      depth.push_back(d);
+      const SE3 T(quat_from_euler_zyx({0.01 * i, 0.02, 0.5 + 0.1 * i}), Vec3(3 + i, 2 * i, -1));
+      truth.camera.push_back({stamps[i], T});
+      truth.body.push_back({stamps[i], T * calibration().T_S_C.inverse(), Vec3(1, 0, 0)});
+    }
+  }
+  void write(DatasetWriter& w) const {
+    for (std::size_t i = 0; i < stamps.size(); ++i)
+      w.add_frame(stamps[i], left[i], right[i], w.wants_depth() ? depth[i] : cv::Mat());
+    w.finish(truth);
+  }
+};
+
+bool same_image(const cv::Mat& a, const cv::Mat& b) {
+  return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0;
+}
+
+double pose_difference(const SE3& a, const SE3& b) { return (a.inverse() * b).log().norm(); }
+
+std::vector<double> numbers_after(const std::string& text, const std::string& key) {
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind(key + ":", 0) == 0) {
+      std::istringstream in(line.substr(key.size() + 1));
+      std::vector<double> out;
+      for (double v; in >> v;) out.push_back(v);
+      return out;
+    }
+  return {};
+}
+
+TEST(KittiExport, FollowsTheOdometryDevkitAndReadsBack) {
+  const fs::path root = test::fresh_temp_dir("kitti_export");
+  const Sequence seq;
+  seq.write(*make_writer(DatasetFormat::kKitti, root, calibration()));
+  const fs::path s = root / "sequences" / "00";
+  for (const char* f : {"000000.png", "000001.png", "000002.png"}) {
+    EXPECT_TRUE(fs::exists(s / "image_0" / f)) << f;
+    EXPECT_TRUE(fs::exists(s / "image_1" / f)) << f;
+  }
+  // calib.txt: P0 = K [I | 0], P1 = K [I | (-B, 0, 0)], i.e. P1(0,3) = -fx B (devkit readme).
+  const std::string calib = slurp(s / "calib.txt");
+  const std::vector<double> P0 = numbers_after(calib, "P0"), P1 = numbers_after(calib, "P1");
+  EXPECT_EQ(P0, (std::vector<double>{480, 0, 40.5, 0, 0, 470, 30.25, 0, 0, 0, 1, 0}));
+  EXPECT_EQ(P1, (std::vector<double>{480, 0, 40.5, -120, 0, 470, 30.25, 0, 0, 0, 1, 0}));
+  EXPECT_EQ(numbers_after(calib, "P2"), P0);
+  EXPECT_EQ(numbers_after(calib, "P3"), P1);
+  EXPECT_EQ(slurp(s / "times.txt"), "1.000000000\n1.100000123\n1.200000000\n");
+  // poses/00.txt: the first line the identity, then T_C0_Ci.
+  std::istringstream poses(slurp(root / "poses" / "00.txt"));
+  std::string first;
+  std::getline(poses, first);
+  EXPECT_EQ(first, "1 0 0 0 0 1 0 0 0 0 1 0");
+
+  const StereoDataset d = read_dataset(root, DatasetFormat::kKitti);
+  EXPECT_EQ(d.rig.camera.fx, 480);
+  EXPECT_EQ(d.rig.camera.fy, 470);
+  EXPECT_EQ(d.rig.camera.cx, 40.5);
+  EXPECT_EQ(d.rig.camera.cy, 30.25);
+  EXPECT_EQ(d.rig.camera.width, 80);
+  EXPECT_EQ(d.rig.camera.height, 60);
+  EXPECT_DOUBLE_EQ(d.rig.baseline_m, 0.25);
+  ASSERT_EQ(d.frames.size(), 3u);
+  ASSERT_EQ(d.camera_gt.size(), 3u);
+  const SE3 T_C0_W = seq.truth.camera[0].T_W_C.inverse();
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(d.frames[i].t_ns, seq.stamps[i]);
+    EXPECT_EQ(d.camera_gt[i].t_ns, seq.stamps[i]);
+    EXPECT_LT(pose_difference(d.camera_gt[i].T_W_C, T_C0_W * seq.truth.camera[i].T_W_C), 1e-12);
+    EXPECT_TRUE(same_image(read_gray(d.frames[i].left), seq.left[i]));
+    EXPECT_TRUE(same_image(read_gray(d.frames[i].right), seq.right[i]));
+  }
+  // The sequence folder itself reads too.
+  EXPECT_EQ(read_dataset(s, DatasetFormat::kKitti).frames.size(), 3u);
+  fs::remove_all(root);
+}
+
+TEST(EurocExport, FollowsTheAslLayoutAndReadsBack) {
+  const fs::path root = test::fresh_temp_dir("euroc_export");
+  const Sequence seq;
+  // The IMU CSV is handed over as a file (the sensor stage wrote it) and moved, bytes as they are.
+  const fs::path staging = root / "staging";
+  fs::create_directories(staging);
+  const std::vector<ImuSample> imu = {{1'000'000'000, Vec3(0.1, 0.2, 0.3), Vec3(0, 0, -9.8)},
+                                      {1'005'000'000, Vec3(0.1, 0.2, 0.4), Vec3(0, 0.1, -9.8)}};
+  write_euroc_imu(staging / "imu.csv", imu);
+  const std::string imu_bytes = slurp(staging / "imu.csv");
+  Sequence with_imu = seq;
+  with_imu.truth.sensor_csvs = {staging / "imu.csv"};
+  const auto writer = make_writer(DatasetFormat::kEuroc, root, calibration());
+  with_imu.write(*writer);
+  const fs::path mav = root / "mav0";
+  EXPECT_EQ(slurp(mav / "imu0" / "data.csv"), imu_bytes);
+  const std::string index = slurp(mav / "cam0" / "data.csv");
+  EXPECT_EQ(index.rfind("#timestamp [ns],filename\n1000000000,1000000000.png\n", 0), 0u);
+  EXPECT_TRUE(fs::exists(mav / "cam1" / "data" / "1100000123.png"));
+  // sensor.yaml as the ASL format describes it.
+  const YAML::Node cam0 = YAML::LoadFile((mav / "cam0" / "sensor.yaml").string());
+  EXPECT_EQ(cam0["sensor_type"].as<std::string>(), "camera");
+  EXPECT_EQ(cam0["intrinsics"].as<std::vector<double>>(),
+            (std::vector<double>{480, 470, 40.5, 30.25}));
+  EXPECT_EQ(cam0["resolution"].as<std::vector<int>>(), (std::vector<int>{80, 60}));
+  EXPECT_EQ(cam0["T_BS"]["rows"].as<int>(), 4);
+  const YAML::Node imu_yaml = YAML::LoadFile((mav / "imu0" / "sensor.yaml").string());
+  EXPECT_EQ(imu_yaml["gyroscope_noise_density"].as<double>(), 1.7e-4);
+  EXPECT_EQ(imu_yaml["accelerometer_random_walk"].as<double>(), 3e-3);
+  EXPECT_EQ(imu_yaml["rate_hz"].as<double>(), 200);
+
+  const StereoDataset d = read_dataset(root, DatasetFormat::kEuroc);
+  EXPECT_DOUBLE_EQ(d.rig.baseline_m, 0.25);  // from cam1's T_BS: cam0's moved along its x
+  EXPECT_EQ(d.rig.camera.fx, 480);
+  EXPECT_LT(pose_difference(d.T_S_C, calibration().T_S_C), 1e-12);
+  ASSERT_EQ(d.frames.size(), 3u);
+  ASSERT_EQ(d.camera_gt.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(d.frames[i].t_ns, seq.stamps[i]);
+    EXPECT_LT(pose_difference(d.camera_gt[i].T_W_C, seq.truth.camera[i].T_W_C), 1e-12);
+    EXPECT_TRUE(same_image(read_gray(d.frames[i].right), seq.right[i]));
+  }
+  ASSERT_EQ(d.imu.size(), 2u);
+  EXPECT_EQ(d.imu[1].gyro_rad_s, imu[1].gyro_rad_s);
+  EXPECT_EQ(d.imu[1].accel_m_s2, imu[1].accel_m_s2);
+  fs::remove_all(root);
+}
+
+TEST(TumRgbdExport, DepthIsSixteenBitAtFiveThousandPerMetre) {
+  const fs::path root = test::fresh_temp_dir("tum_export");
+  const Sequence seq;
+  const auto writer = make_writer(DatasetFormat::kTumRgbd, root, calibration());
+  ASSERT_TRUE(writer->wants_depth());
+  seq.write(*writer);
+  const std::string rgb = slurp(root / "rgb.txt");
+  EXPECT_NE(rgb.find("# timestamp filename\n1.000000000 rgb/1.000000000.png\n"), std::string::npos);
+  EXPECT_NE(slurp(root / "depth.txt").find("1.100000123 depth/1.100000123.png\n"),
+            std::string::npos);
+  const cv::Mat depth =
+      cv::imread((root / "depth" / "1.100000123.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(depth.type(), CV_16UC1);
+  std::size_t checked = 0;
+  for (int r = 0; r < 60; ++r)
+    for (int c = 0; c < 80; ++c) {
+      const double z = seq.depth[1].at<float>(r, c);
+      const int expected = z * 5000 <= 65535 ? static_cast<int>(std::lround(z * 5000)) : 0;
+      if (!std::isfinite(z)) continue;
+      ASSERT_EQ(depth.at<std::uint16_t>(r, c), expected) << r << "," << c;
+      ++checked;
+    }
+  EXPECT_EQ(checked, 60u * 80u - 1);
+  EXPECT_EQ(depth.at<std::uint16_t>(0, 0), 0);  // infinite: no depth
+  const Trajectory gt = read_tum(root / "groundtruth.txt");
+  ASSERT_EQ(gt.size(), 3u);
+  EXPECT_LT(pose_difference(gt[2].T_W_C, seq.truth.camera[2].T_W_C), 1e-12);
+  EXPECT_TRUE(same_image(
+      cv::imread((root / "rgb" / "1.200000000.png").string(), cv::IMREAD_UNCHANGED), seq.left[2]));
+  fs::remove_all(root);
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const UserError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(DatasetReaders, NameTheFileLineAndExpectation) {
+  const fs::path root = test::fresh_temp_dir("dataset_errors");
+  Sequence{}.write(*make_writer(DatasetFormat::kKitti, root, calibration()));
+  const fs::path calib = root / "sequences" / "00" / "calib.txt";
+  std::ofstream(calib) << "P0: 1 2 3\nP1: 1 0 0 0 0 1 0 0 0 0 1 0\n";
+  std::string e = error_of([&] { read_dataset(root, DatasetFormat::kKitti); });
+  EXPECT_NE(e.find(calib.string() + ":1: P0: got 3 numbers, expected 12"), std::string::npos) << e;
+  std::ofstream(calib) << "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nP1: 1 0 0 0 0 1 0 0 0 0 1 0\n";
+  e = error_of([&] { read_dataset(root, DatasetFormat::kKitti); });
+  EXPECT_NE(e.find("not a rectified pair"), std::string::npos) << e;
+  e = error_of([&] { read_dataset(root, DatasetFormat::kKitti, {"07"}); });
+  EXPECT_NE(e.find("expected sequences/07/"), std::string::npos) << e;
+  e = error_of([&] { read_dataset(root / "nowhere", DatasetFormat::kEuroc); });
+  EXPECT_NE(e.find("no such dataset folder"), std::string::npos) << e;
+  e = error_of([] { format_from_name("rosbag"); });
+  EXPECT_NE(e.find("got 'rosbag', expected one of: kitti, euroc, tum-rgbd"), std::string::npos);
+
+  // EuRoC: a raw (distorted) pair is refused with what to do; a bad stamp names its line.
+  const fs::path eu = test::fresh_temp_dir("dataset_errors_euroc");
+  Sequence{}.write(*make_writer(DatasetFormat::kEuroc, eu, calibration()));
+  const fs::path cam1 = eu / "mav0" / "cam1" / "sensor.yaml";
+  const std::string good_yaml = slurp(cam1);
+  std::string yaml = good_yaml;
+  yaml.replace(yaml.find("[0.0, 0.0, 0.0, 0.0]"), 20, "[-0.28, 0.07, 0.0002, 0.00002]");
+  std::ofstream(cam1) << yaml;
+  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  EXPECT_NE(e.find("not a rectified pair"), std::string::npos) << e;
+  std::ofstream(cam1) << good_yaml;
+  std::ofstream(eu / "mav0" / "cam0" / "data.csv") << "#timestamp [ns],filename\n12x,a.png\n";
+  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  EXPECT_NE(e.find("data.csv:2: timestamp: got '12x'"), std::string::npos) << e;
+  fs::remove_all(root);
+  fs::remove_all(eu);
+}
+
+TEST(PoseAt, InterpolatesBetweenNeighboursAndNothingOutside) {
+  const Trajectory t = {{0, SE3(Quat::Identity(), Vec3(0, 0, 0))},
+                        {10, SE3(Quat::Identity(), Vec3(1, 2, 0))}};
+  EXPECT_LT((pose_at(t, 5)->translation() - Vec3(0.5, 1, 0)).norm(), 1e-15);
+  EXPECT_EQ(pose_at(t, 10)->translation(), Vec3(1, 2, 0));
+  EXPECT_FALSE(pose_at(t, 11).has_value());
+  EXPECT_FALSE(pose_at(t, -1).has_value());
+}
+
+}  // namespace
+}  // namespace driftlab::dataset

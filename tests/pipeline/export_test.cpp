@@ -1,0 +1,181 @@
+// `driftlab export` and `driftlab vo`: a built-in VO on an exported dataset gives the estimate
+// of a scenario run, frame for frame (same images, same stamps, same dropped frames).
+#include "pipeline/export_stage.hpp"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "core/csv.hpp"
+#include "core/trajectory_io.hpp"
+#include "pipeline/dataset_run.hpp"
+#include "pipeline/run.hpp"
+#include "pipeline/vo_stage.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace driftlab::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+using test::slurp;
+
+Scenario short_crossing_with_drops() {
+  Scenario s = load_scenario(test::source_dir() / "scenarios/river_crossing.yaml");
+  s.pipeline.max_frames = 30;
+  s.pipeline.vo = {VoAlgorithm::kSparse, VoAlgorithm::kSparseKf};
+  s.sensors.camera.clock.drop_probability = 0.1;
+  return s;
+}
+
+// frames.csv's VO cells of each row, without the timing column (NAME_ms). The mean depth is
+// rounded to 12 significant digits: EuRoC's rig comes back through cam1's T_BS, whose baseline
+// differs from the scenario's in the last bits.
+std::vector<std::string> vo_cells(const fs::path& frames_csv, const std::string& name) {
+  std::istringstream in(slurp(frames_csv));
+  std::string line;
+  std::getline(in, line);
+  const auto header = split_csv_line(line);
+  const auto names = split_csv_line(vo_csv_header(name).substr(1));
+  const std::set<std::string> columns(names.begin(), names.end());
+  std::vector<std::string> rows;
+  while (std::getline(in, line)) {
+    const auto cells = split_csv_line(line);
+    std::string row = cells[0];  // t_ns
+    for (std::size_t i = 0; i < header.size(); ++i)
+      if (header[i] == name + "_mean_depth_m" && !cells[i].empty())
+        row += fmt::format(",{:.12g}", std::stod(cells[i]));
+      else if (columns.count(header[i]) && header[i] != name + "_ms")
+        row += "," + cells[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// The run's estimate against the dataset run's, both expressed relative to their first pose.
+double largest_relative_difference(const Trajectory& a, const Trajectory& b) {
+  EXPECT_EQ(a.size(), b.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    EXPECT_EQ(a[i].t_ns, b[i].t_ns);
+    const SE3 ra = a.front().T_W_C.inverse() * a[i].T_W_C;
+    const SE3 rb = b.front().T_W_C.inverse() * b[i].T_W_C;
+    worst = std::max(worst, (ra.inverse() * rb).log().norm());
+  }
+  return worst;
+}
+
+class ExportRoundTrip : public ::testing::TestWithParam<dataset::DatasetFormat> {};
+
+TEST_P(ExportRoundTrip, BuiltInVoOnTheExportGivesTheRunsEstimate) {
+  const fs::path root = test::unused_temp_path("export_rt");
+  const Scenario sc = short_crossing_with_drops();
+  const fs::path run = root / "run", exported = root / "export", vo = root / "vo";
+  run_scenario(sc, run, {});
+  ExportOptions o;
+  o.format = GetParam();
+  const ExportSummary summary = export_dataset(sc, exported, o);
+  const Trajectory run_sparse = read_tum(run / "estimates/sparse.tum");
+  ASSERT_LT(run_sparse.size(), 30u);  // frames were dropped
+  EXPECT_EQ(summary.frames, run_sparse.size());
+  EXPECT_EQ(slurp(exported / "scenario.resolved.yaml"), slurp(run / "scenario.resolved.yaml"));
+
+  const dataset::StereoDataset data = dataset::read_dataset(exported, GetParam());
+  const Scenario settings = load_scenario(exported / "scenario.resolved.yaml");
+  run_on_dataset(data, settings, vo, {});
+  for (const char* name : {"sparse", "sparse_kf"}) {
+    const Trajectory from_run = read_tum(run / "estimates" / (std::string(name) + ".tum"));
+    const Trajectory from_vo = read_tum(vo / "estimates" / (std::string(name) + ".tum"));
+    EXPECT_LT(largest_relative_difference(from_run, from_vo), 1e-9) << name;
+    EXPECT_EQ(vo_cells(run / "frames.csv", name), vo_cells(vo / "frames.csv", name)) << name;
+  }
+  // The dataset's ground truth is the run's (KITTI: relative to the first camera).
+  const Trajectory run_gt = read_tum(run / "groundtruth.tum");
+  const Trajectory vo_gt = read_tum(vo / "groundtruth.tum");
+  const auto vo_gt0 = dataset::pose_at(vo_gt, run_gt.front().t_ns);
+  ASSERT_TRUE(vo_gt0.has_value());
+  std::size_t compared = 0;
+  const auto exact = [&](TimeNs t) {
+    return std::any_of(vo_gt.begin(), vo_gt.end(),
+                       [&](const StampedPose& q) { return q.t_ns == t; });
+  };
+  for (const StampedPose& p : run_gt) {  // EuRoC: body poses at 200 Hz, interpolated
+    const auto T = dataset::pose_at(vo_gt, p.t_ns);
+    // KITTI has a pose per delivered image only: no comparison at a dropped frame's time.
+    if (!T || (GetParam() == dataset::DatasetFormat::kKitti && !exact(p.t_ns))) continue;
+    const SE3 expected = run_gt.front().T_W_C.inverse() * p.T_W_C;
+    EXPECT_LT(((vo_gt0->inverse() * *T).inverse() * expected).log().norm(), 1e-5) << p.t_ns;
+    ++compared;
+  }
+  EXPECT_GE(compared, run_sparse.size() - 1);
+  const auto metrics = nlohmann::json::parse(slurp(vo / "metrics.json"));
+  EXPECT_TRUE(metrics["algorithms"].contains("sparse"));
+  EXPECT_EQ(metrics["dataset"]["frames_used"].get<std::size_t>(), run_sparse.size());
+  fs::remove_all(root);
+}
+
+TEST_P(ExportRoundTrip, ExportIsTheSameBytesWhateverTheThreadCount) {
+  const fs::path root = test::unused_temp_path("export_threads");
+  Scenario sc = short_crossing_with_drops();
+  sc.pipeline.max_frames = 8;
+  ExportOptions o;
+  o.format = GetParam();
+  sc.pipeline.threads = 1;
+  export_dataset(sc, root / "one", o);
+  sc.pipeline.threads = 2;
+  export_dataset(sc, root / "two", o);
+  std::size_t files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(root / "one")) {
+    if (!e.is_regular_file()) continue;
+    const fs::path rel = fs::relative(e.path(), root / "one");
+    if (rel == "scenario.resolved.yaml") continue;  // says threads: 1 or 2
+    EXPECT_EQ(slurp(e.path()), slurp(root / "two" / rel)) << rel;
+    ++files;
+  }
+  EXPECT_GT(files, 10u);
+  fs::remove_all(root);
+}
+
+INSTANTIATE_TEST_SUITE_P(Formats, ExportRoundTrip,
+                         ::testing::Values(dataset::DatasetFormat::kKitti,
+                                           dataset::DatasetFormat::kEuroc),
+                         [](const auto& info) {
+                           return std::string(
+                               info.param == dataset::DatasetFormat::kKitti ? "Kitti" : "Euroc");
+                         });
+
+TEST(ExportCli, WritesEachFormatAndVoReadsIt) {
+  const fs::path root = test::unused_temp_path("export_cli");
+  const std::string scenario = (test::source_dir() / "scenarios/river_crossing.yaml").string();
+  auto r = test::run_cli({"export", scenario, "--format", "tum-rgbd", "--frames", "3", "--out",
+                          (root / "tum").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(root / "tum" / "depth.txt"));
+  EXPECT_TRUE(fs::exists(root / "tum" / "info.yaml"));
+  r = test::run_cli({"export", scenario, "--format", "rosbag", "--out", (root / "x").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("expected one of: kitti, euroc, tum-rgbd"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(root / "x"));  // nothing half-written
+  r = test::run_cli({"export", scenario, "--frames", "5", "--out", (root / "kitti").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_cli(
+      {"vo", (root / "kitti").string(), "--algo", "sparse,pnp", "--out", (root / "vo").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(root / "vo" / "estimates" / "pnp.tum"));
+  EXPECT_TRUE(fs::exists(root / "vo" / "tables.md"));
+  r = test::run_cli(
+      {"vo", (root / "kitti").string(), "--algo", "orb", "--out", (root / "vo2").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("'orb'"), std::string::npos) << r.err;
+  r = test::run_cli(
+      {"vo", (root / "tum").string(), "--format", "tum-rgbd", "--out", (root / "vo3").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("has one camera"), std::string::npos) << r.err;
+  fs::remove_all(root);
+}
+
+}  // namespace
+}  // namespace driftlab::pipeline
