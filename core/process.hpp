@@ -48,6 +48,9 @@ ExitStatus wait_process(pid_t pid);
 /// The first executable file called `name` in $PATH, or nullopt.
 std::optional<std::filesystem::path> find_on_path(const std::string& name);
 
+/// `text` quoted for /bin/sh: 'text', with each ' written as '\''.
+std::string shell_quote(const std::string& text);
+
 /// True when a process with this pid exists on this machine (kill(pid, 0)).
 bool process_alive(pid_t pid);
 

@@ -16,8 +16,10 @@
 // (DRIFTLAB_DEMAND), so that what they write can always be read back.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/se3.hpp"
@@ -46,6 +48,13 @@ struct ImuSample {
 inline constexpr double kUnitTolerance = 1e-3;
 
 enum class TrajectoryFormat { kTum, kKitti, kEuroc };
+
+/// Names for the scenario reader (yaml::enum_name and friends).
+constexpr auto enum_table(TrajectoryFormat) {
+  return std::array{std::pair{TrajectoryFormat::kTum, "tum"},
+                    std::pair{TrajectoryFormat::kKitti, "kitti"},
+                    std::pair{TrajectoryFormat::kEuroc, "euroc"}};
+}
 
 /// "tum", "kitti" or "euroc" (any case); UserError listing these otherwise.
 TrajectoryFormat format_from_name(std::string_view name);

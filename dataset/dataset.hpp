@@ -29,14 +29,9 @@
 #include "core/camera.hpp"
 #include "core/se3.hpp"
 #include "core/trajectory_io.hpp"
+#include "dataset/dataset_format.hpp"
 
 namespace driftlab::dataset {
-
-enum class DatasetFormat { kKitti, kEuroc, kTumRgbd };
-
-/// "kitti", "euroc" or "tum-rgbd" (any case); UserError listing these otherwise.
-DatasetFormat format_from_name(std::string_view name);
-std::string_view format_name(DatasetFormat format);
 
 /// TUM RGB-D depth PNGs: 16-bit value = depth [m] * 5000; 0 means no depth.
 inline constexpr double kTumDepthScale = 5000.0;

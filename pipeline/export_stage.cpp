@@ -11,24 +11,11 @@
 #include "pipeline/render_stage.hpp"
 #include "pipeline/run.hpp"
 #include "pipeline/sensor_stage.hpp"
-#include "sim/sensors/clock.hpp"
 
 namespace driftlab::pipeline {
 namespace fs = std::filesystem;
 
 namespace {
-
-// The IMU's frame S in the body frame (the identity when there is no IMU).
-SE3 imu_T_B_S(const Scenario& sc) {
-  return sc.sensors.imu.enabled ? sim::SensorMount::from_options(sc.sensors.imu.mount).T_B_S()
-                                : SE3();
-}
-
-// EuRoC's ground truth rate is 200 Hz: every n-th physics step, at most that often.
-std::size_t body_decimation(const Scenario& sc) {
-  return std::max<std::size_t>(
-      1, static_cast<std::size_t>(std::lround(sc.vessel.physics_rate_hz / 200.0)));
-}
 
 cv::Mat view(const sim::GrayImage& img) {
   return cv::Mat(img.height, img.width, CV_8UC1, const_cast<std::uint8_t*>(img.pixels.data()));
@@ -51,7 +38,7 @@ std::string ExportSummary::brief() const {
 dataset::ExportCalibration export_calibration(const Scenario& sc) {
   dataset::ExportCalibration cal;
   cal.rig = rig_of(sc.sensors.camera);
-  cal.T_S_C = imu_T_B_S(sc).inverse() * camera_mount_T_B_C(sc.sensors.camera.mount);
+  cal.T_S_C = imu_mount_T_B_S(sc).inverse() * camera_mount_T_B_C(sc.sensors.camera.mount);
   cal.camera_rate_hz = sc.sensors.camera.rate_hz;
   const auto& imu = sc.sensors.imu;
   if (imu.enabled)
@@ -77,18 +64,9 @@ ExportSummary export_dataset(const Scenario& sc, const fs::path& out_dir,
   fs::create_directories(staging);
   SensorStage sensors(sc, staging);
   dataset::ExportTruth truth;
-  const SE3 T_B_S = imu_T_B_S(sc);
-  const std::size_t every = body_decimation(sc);
-  std::size_t step = 0;
-  const MissionTruth mission = simulate_mission(
-      sc,
-      [&](const sim::BodySample& b) {
-        if (step++ % every) return;
-        const Vec3 v_S_B = b.state.v_B + b.state.w_B.cross(T_B_S.translation());
-        truth.body.push_back(
-            {b.t_ns, b.state.T_W_B() * T_B_S, b.state.q_W_B.toRotationMatrix() * v_S_B});
-      },
-      &sensors);
+  MissionTruth mission =
+      simulate_mission(sc, nullptr, &sensors, options.format == dataset::DatasetFormat::kEuroc);
+  truth.body = std::move(mission.imu_states);
   if (mission.camera_gt.empty()) throw UserError("scenario '" + sc.name + "': no camera frames");
   const sim::SceneGeometry scene = scene_for_track(sc, mission.camera_gt);
   const SensorData sensor_data = sensors.finish(&scene);

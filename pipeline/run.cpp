@@ -17,6 +17,7 @@
 #include "eval/evaluate.hpp"
 #include "fusion/ca_smoother.hpp"
 #include "pipeline/camera_stage.hpp"
+#include "pipeline/external_vo.hpp"
 #include "pipeline/filter_stage.hpp"
 #include "pipeline/frame_source.hpp"
 #include "pipeline/progress.hpp"
@@ -26,6 +27,7 @@
 #include "report/run_report.hpp"
 #include "scenes/build_scene.hpp"
 #include "sim/render/renderer.hpp"
+#include "sim/sensors/clock.hpp"
 #include "sim/waves/wave_field.hpp"
 #include "vo/sparse/sparse_vo.hpp"
 
@@ -149,6 +151,7 @@ struct Track {
   std::unique_ptr<fusion::ConstantAccelerationSmoother> smoother;  // set for NAME_ca streams
   std::unique_ptr<FilterTrack> filter;  // NAME_ned_kf, NAME_ned_pf, NAME_eskf streams
   std::size_t source = 0;               // for a smoothed stream: the VO track it follows
+  bool external = false;                // an external VO's estimate (pipeline.external_vo)
   Trajectory estimate;
   std::vector<vo::VoResult> results;  // per frame time; a dropped frame's is invalid
   double vo_ms = 0;
@@ -184,11 +187,11 @@ sim::SceneGeometry scene_for_track(const Scenario& sc, const Trajectory& camera_
 }
 
 static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scene,
-                              const SensorData& sensor_data, const Trajectory& camera_gt,
-                              const std::vector<FrameTruth>& frame_truth,
-                              const std::vector<EulerZYX>& platform,
+                              const SensorData& sensor_data, const MissionTruth& mission,
                               const std::filesystem::path& dir, const RunOptions& options,
                               RunSummary* summary, nlohmann::json* metrics) {
+  const Trajectory& camera_gt = mission.camera_gt;
+  const std::vector<EulerZYX>& platform = mission.platform;
   const RngStreams rng(sc.seed);
   const StereoRig rig = rig_of(sc.sensors.camera);
   // The camera's clock: stamps (offset, jitter) and dropped frames.
@@ -198,7 +201,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   // Stage: render and camera effects (the scene built once, uploaded once), on a thread of
   // their own when the run has more than one.
   const int threads = run_threads(sc.pipeline.threads);
-  FrameSource source(sc, scene, frame_truth, stamps, threads);
+  ExternalVoStage external(sc, dir);  // exports of the frames for the external VOs
+  FrameSource source(sc, scene, mission.frames, stamps, threads, 4, external.wants_depth());
   (*metrics)["timing"]["threads"] = threads;
 
   // Stages: VO and fusion. VO sees images and the rig only; the pipeline
@@ -296,10 +300,24 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
       tr.estimate.push_back({t, tr.estimate.back().T_W_C * step});  // river paper Eq. (3)
     }
     frames_csv.write(row + "\n");
+    external.add_frame(t, img, camera_gt[k]);
   }
   progress.update(camera_gt.size());
   progress.finish();
   frames_csv.commit();
+  // Stage: external VOs, on the exports of the same frames.
+  for (ExternalVoResult& r : external.finish(mission.imu_states)) {
+    (*metrics)["external_vo"][r.name] = r.record;
+    if (!r.warning.empty()) warnings.push_back(r.warning);
+    if (!r.ok) continue;
+    Track t;
+    t.name = r.name;
+    t.external = true;
+    t.estimate = std::move(r.estimate);
+    t.results.resize(camera_gt.size());
+    for (auto& v : t.results) v.reason = "external VO: no per-frame statistics";
+    tracks.push_back(std::move(t));
+  }
   std::filesystem::create_directories(dir / "estimates");
   for (const auto& tr : tracks) {
     write_tum(dir / "estimates" / (tr.name + ".tum"), tr.estimate);
@@ -312,7 +330,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   std::string sections;
   for (std::size_t i = 0; i < tracks.size(); ++i) {
     const Track& tr = tracks[i];
-    const Track& src = tr.vo ? tr : tracks[tr.source];
+    const Track& src = tr.vo || tr.external ? tr : tracks[tr.source];
     eval::EvaluationInput in;
     in.gt = camera_gt;
     in.est = tr.estimate;
@@ -361,6 +379,15 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
                                    "from the previous frame in orange (Fig. 3)",
                                    sample_frame, tr.name),
                        "plots/" + tr.name + "_matches.png"});
+  if (metrics->contains("external_vo")) {  // every external VO's fate, failures included
+    report +=
+        "## External VOs\n\n| name | status | exit | seconds | message |\n|---|---|---|---|---|\n";
+    for (const auto& [name, r] : (*metrics)["external_vo"].items())
+      report += fmt::format("| {} | {} | {} | {:.2f} | {} |\n", name,
+                            r["status"].get<std::string>(), r["exit"].get<std::string>(),
+                            r["seconds"].get<double>(), r["message"].get<std::string>());
+    report += "\nEach command's output is in external/NAME/log.txt.\n\n";
+  }
   const std::string tables = report;
   if (!plots.empty()) report += "## Plots\n\n";
   for (const auto& p : plots) report += fmt::format("![{}]({})\n\n", p.title, p.file);
@@ -384,9 +411,14 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   summary->render_pairs_per_s = (*metrics)["timing"]["render_pairs_per_s"];
 }
 
+SE3 imu_mount_T_B_S(const Scenario& sc) {
+  return sc.sensors.imu.enabled ? sim::SensorMount::from_options(sc.sensors.imu.mount).T_B_S()
+                                : SE3();
+}
+
 MissionTruth simulate_mission(const Scenario& sc,
                               const std::function<void(const sim::BodySample&)>& on_physics,
-                              SensorStage* sensors) {
+                              SensorStage* sensors, bool imu_states) {
   const SE3 T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
   MissionTruth truth;
   const auto on_frame = [&](const sim::BodySample& b) {
@@ -396,10 +428,22 @@ MissionTruth simulate_mission(const Scenario& sc,
     truth.frames.push_back({ns_to_seconds(b.t_ns), b.state.T_W_B(), twist});
     truth.platform.push_back(euler_zyx_from_quat(b.state.q_W_B));
   };
+  // EuRoC's ground truth rate is 200 Hz: every n-th physics step, at most that often.
+  const std::size_t every = std::max<std::size_t>(
+      1, static_cast<std::size_t>(std::lround(sc.vessel.physics_rate_hz / 200.0)));
+  const SE3 T_B_S = imu_mount_T_B_S(sc);
+  std::size_t step = 0;
+  const auto physics = [&](const sim::BodySample& b) {
+    if (on_physics) on_physics(b);
+    if (!imu_states || step++ % every) return;
+    const Vec3 v_S_B = b.state.v_B + b.state.w_B.cross(T_B_S.translation());
+    truth.imu_states.push_back(
+        {b.t_ns, b.state.T_W_B() * T_B_S, b.state.q_W_B.toRotationMatrix() * v_S_B});
+  };
   truth.motion = sensors ? simulate_scenario_motion(
-                               sc, on_physics, on_frame, sensors->sample_times(motion_end_s(sc)),
+                               sc, physics, on_frame, sensors->sample_times(motion_end_s(sc)),
                                [&](const sim::BodySample& b) { sensors->on_sample(b); })
-                         : simulate_scenario_motion(sc, on_physics, on_frame);
+                         : simulate_scenario_motion(sc, physics, on_frame);
   return truth;
 }
 
@@ -416,12 +460,13 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
   body.write(body_csv_header());
   const auto t_physics = SteadyClock::now();
   SensorStage sensors(sc, dir.path());
+  bool euroc_export = false;  // an external VO reads EuRoC: keep the IMU's true states
+  for (const auto& e : sc.pipeline.external_vo)
+    euroc_export = euroc_export || e.format == dataset::DatasetFormat::kEuroc;
   MissionTruth truth = simulate_mission(
-      sc, [&](const sim::BodySample& b) { body.write(body_csv_row(b)); }, &sensors);
+      sc, [&](const sim::BodySample& b) { body.write(body_csv_row(b)); }, &sensors, euroc_export);
   summary.motion = truth.motion;
   const Trajectory& camera_gt = truth.camera_gt;
-  const std::vector<FrameTruth>& frame_truth = truth.frames;
-  const std::vector<EulerZYX>& platform = truth.platform;
   summary.physics_s = seconds_since(t_physics);
   body.commit();
   write_tum(dir.path() / "groundtruth.tum", camera_gt);
@@ -439,10 +484,11 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
   metrics["sensors"] = sensor_data.stats;
   metrics["timing"]["sensors_s"] = seconds_since(t_sensors);
 
-  const bool run_vo = !options.only_motion && !sc.pipeline.vo.empty() && !camera_gt.empty();
+  const bool run_vo = !options.only_motion &&
+                      (!sc.pipeline.vo.empty() || !sc.pipeline.external_vo.empty()) &&
+                      !camera_gt.empty();
   if (run_vo)
-    run_vision_stages(sc, *scene, sensor_data, camera_gt, frame_truth, platform, dir.path(),
-                      options, &summary, &metrics);
+    run_vision_stages(sc, *scene, sensor_data, truth, dir.path(), options, &summary, &metrics);
 
   summary.total_s = seconds_since(t0);
   metrics["version"] = DRIFTLAB_VERSION;

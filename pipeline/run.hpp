@@ -13,6 +13,7 @@
 #include "core/rotation.hpp"
 #include "core/se3.hpp"
 #include "core/trajectory_io.hpp"
+#include "dataset/dataset.hpp"
 #include "pipeline/camera_stage.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/sensor_stage.hpp"
@@ -43,6 +44,9 @@ struct RunSummary {
 /// x), then roll, pitch, yaw (ZYX) of the mount rotate it.
 SE3 camera_mount_T_B_C(const sim::MountOptions& mount);
 
+/// Pose of the IMU's frame S in the body frame (sensors.imu.mount); the identity without an IMU.
+SE3 imu_mount_T_B_S(const Scenario& scenario);
+
 /// The physics stage: simulates the scenario's vessel along its mission;
 /// `on_physics` gets every physics step, `on_frame` the body at every camera
 /// frame time (round(k * 1e9 / rate) ns, up to pipeline.max_frames).
@@ -68,13 +72,15 @@ struct MissionTruth {
   Trajectory camera_gt;            ///< left camera at each frame time
   std::vector<FrameTruth> frames;  ///< body pose and twist at each frame (the camera stage)
   std::vector<EulerZYX> platform;  ///< body attitude at each frame (covariate h)
+  /// The IMU frame's true state at most every 5 ms (EuRoC's ground truth), when asked for.
+  std::vector<dataset::BodyState> imu_states;
 };
 
 /// The physics stage: the mission simulated, `on_physics` called at every physics step and
-/// `sensors` (may be null) fed at its sample times.
+/// `sensors` (may be null) fed at its sample times; `imu_states`: keep them (EuRoC exports).
 MissionTruth simulate_mission(const Scenario& scenario,
                               const std::function<void(const sim::BodySample&)>& on_physics,
-                              SensorStage* sensors);
+                              SensorStage* sensors, bool imu_states = false);
 
 /// The scene around a camera track (river reach tiles covering its northings).
 sim::SceneGeometry scene_for_track(const Scenario& scenario, const Trajectory& camera_gt);

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <set>
+
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -107,11 +109,30 @@ void validate_scenario(const Scenario& s, const std::string& label) {
     errors.add(
         "pipeline.fusion: got filters but no VO to feed them, expected pipeline.vo to "
         "name at least one VO algorithm");
+  std::set<std::string> external_names;
+  for (const auto& e : s.pipeline.external_vo) {
+    constexpr std::string_view kNameChars =
+        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-";
+    if (yaml::enum_from_name<VoAlgorithm>(e.name))
+      errors.add(fmt::format(
+          "pipeline.external_vo: name: got '{}', a built-in VO's name, expected another name",
+          e.name));
+    else if (e.name.find_first_not_of(kNameChars) != std::string::npos)
+      errors.add(
+          fmt::format("pipeline.external_vo: name: got '{}', expected letters, digits, "
+                      "'_' and '-' only (it names files)",
+                      e.name));
+    else if (!external_names.insert(e.name).second)
+      errors.add(fmt::format(
+          "pipeline.external_vo: name: got '{}' twice, expected a different name for each",
+          e.name));
+  }
   // The camera clock's stamps must stay within the association tolerance of
   // the true frame times, or no estimate would be paired with ground truth.
   const auto& clock = s.sensors.camera.clock;
   const double stamp_error_s = (std::abs(clock.offset_ms) + 3 * clock.jitter_ms) * 1e-3;
-  if (!s.pipeline.vo.empty() && stamp_error_s > s.eval.association_tolerance_s)
+  if ((!s.pipeline.vo.empty() || !s.pipeline.external_vo.empty()) &&
+      stamp_error_s > s.eval.association_tolerance_s)
     errors.add(fmt::format(
         "sensors.camera.clock: got offset_ms {} and jitter_ms {}, stamps up to {} s from the "
         "true frame times, expected at most eval.association_tolerance_s = {} s (raise it, "

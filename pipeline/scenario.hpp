@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "core/trajectory_io.hpp"
 #include "core/yaml_io.hpp"
+#include "dataset/dataset_format.hpp"
 #include "eval/eval_options.hpp"
 #include "fusion/ca_smoother.hpp"
 #include "fusion/eskf.hpp"
@@ -46,9 +48,47 @@ constexpr auto enum_table(FusionAlgorithm) {
 }
 
 /// Which stages run.
+/// A VO of the user's, run as a command on an export of the run's own frames (issue 17).
+struct ExternalVoOptions {
+  std::string name;
+  std::string command;
+  dataset::DatasetFormat format = dataset::DatasetFormat::kKitti;
+  TrajectoryFormat output = TrajectoryFormat::kTum;
+  double timeout_s = 600;
+  bool keep_dataset = false;
+
+  template <class A>
+  void visit(A& a) {
+    a("name", name,
+      "Name of the estimate (estimates/NAME.tum, tables, metrics): letters, digits, '_' and "
+      "'-', not a built-in VO's name",
+      yaml::non_empty());
+    a("command", command,
+      "Shell command (/bin/sh -c) run once the frames are exported; placeholders: {dir} the "
+      "dataset (KITTI: its sequence folder with calib.txt; EuRoC and TUM: the folder holding "
+      "mav0/ or rgb.txt), {root} the export's root (info.yaml), {out} the trajectory file the "
+      "command must write, {driftlab} this driftlab executable",
+      yaml::non_empty());
+    a("format", format, "Layout of the export the command reads (driftlab export --format)");
+    a("output", output,
+      "Format of the trajectory the command writes at {out}: tum or kitti (left-camera poses, "
+      "x right, y down, z forward, in any world frame; KITTI: one pose per exported image) or "
+      "euroc (body = IMU poses, as EuRoC's ground truth; turned into the left camera with "
+      "the export's T_BS)");
+    a("timeout_s", timeout_s,
+      "Wall-clock limit of the command [s]; past it the command's process group is killed and "
+      "the failure recorded",
+      yaml::positive());
+    a("keep_dataset", keep_dataset,
+      "Keep the exported frames in external/NAME/ after the command (they are large: about "
+      "0.5 MB per stereo pair at 640x480)");
+  }
+};
+
 struct PipelineOptions {
   std::vector<VoAlgorithm> vo{VoAlgorithm::kSparse};
   std::vector<FusionAlgorithm> fusion{FusionAlgorithm::kCaSmoother};
+  std::vector<ExternalVoOptions> external_vo;
   int max_frames = 0;
   int threads = 0;
   // Options of each algorithm (used when it runs).
@@ -65,6 +105,9 @@ struct PipelineOptions {
   void visit(A& a) {
     a("vo", vo, "Visual odometry algorithms to run");
     a("fusion", fusion, "Filters and smoothers to run on the VO output");
+    a("external_vo", external_vo,
+      "VOs of your own, each a command run on an export of this run's frames and evaluated "
+      "with the built-in ones (README: External VOs)");
     a("max_frames", max_frames, "Stop after this many stereo frames (0 = whole mission)",
       yaml::non_negative());
     a("threads", threads,

@@ -1,0 +1,237 @@
+#include "pipeline/external_vo.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/file_io.hpp"
+#include "core/process.hpp"
+#include "core/stopwatch.hpp"
+#include "pipeline/export_stage.hpp"
+
+namespace driftlab::pipeline {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::size_t kLogTail = 2000;
+
+std::string log_tail(const fs::path& log) {
+  std::error_code ec;
+  if (!fs::exists(log, ec)) return "";
+  const std::string text = read_text_file(log, "command log");
+  return text.size() <= kLogTail ? text : "..." + text.substr(text.size() - kLogTail);
+}
+
+std::string extension(TrajectoryFormat f) {
+  switch (f) {
+    case TrajectoryFormat::kTum:
+      return "tum";
+    case TrajectoryFormat::kKitti:
+      return "txt";
+    case TrajectoryFormat::kEuroc:
+      return "csv";
+  }
+  return "txt";
+}
+
+cv::Mat view(const sim::GrayImage& img) {
+  return cv::Mat(img.height, img.width, CV_8UC1, const_cast<std::uint8_t*>(img.pixels.data()));
+}
+
+cv::Mat view(const sim::DepthImage& d) {
+  if (d.depth_m.empty()) return {};
+  return cv::Mat(d.height, d.width, CV_32FC1, const_cast<float*>(d.depth_m.data()));
+}
+
+// Runs `command` under coreutils' timeout, which kills its whole process group at the limit.
+ExitStatus run_with_timeout(const std::string& command, double timeout_s, const fs::path& log) {
+  const auto timeout = find_on_path("timeout");
+  if (!timeout) throw UserError("external VO: coreutils' 'timeout' is not on PATH");
+  ProcessSpec spec;
+  spec.executable = *timeout;
+  spec.args = {"--kill-after=5", fmt::format("{}s", timeout_s), "/bin/sh", "-c", command};
+  spec.output_file = log;
+  return wait_process(spawn_process(spec));
+}
+
+// The angle between where the estimate and the truth went from the first frame until the
+// truth had moved `metres`, in the first camera's frame [deg]; nothing if it never did.
+std::optional<double> heading_disagreement_deg(const Trajectory& est, const Trajectory& truth,
+                                               double metres) {
+  for (std::size_t i = 1; i < std::min(est.size(), truth.size()); ++i) {
+    const Vec3 t = (truth.front().T_W_C.inverse() * truth[i].T_W_C).translation();
+    if (t.norm() < metres) continue;
+    const Vec3 e = (est.front().T_W_C.inverse() * est[i].T_W_C).translation();
+    if (e.norm() == 0) return 180.0;
+    return std::acos(std::clamp(t.dot(e) / (t.norm() * e.norm()), -1.0, 1.0)) * 180 /
+           std::numbers::pi;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::string expand_command(const std::string& command, const fs::path& dir, const fs::path& root,
+                           const fs::path& out, const fs::path& driftlab) {
+  std::string result;
+  for (std::size_t i = 0; i < command.size();) {
+    if (command[i] != '{') {
+      result += command[i++];
+      continue;
+    }
+    const std::size_t close = command.find('}', i);
+    const std::string key = close == std::string::npos ? "" : command.substr(i + 1, close - i - 1);
+    const fs::path* value = key == "dir"        ? &dir
+                            : key == "root"     ? &root
+                            : key == "out"      ? &out
+                            : key == "driftlab" ? &driftlab
+                                                : nullptr;
+    if (!value)
+      throw UserError(fmt::format(
+          "pipeline.external_vo: command: got '{}', expected placeholders {{dir}}, {{root}}, "
+          "{{out}} or {{driftlab}} only",
+          command.substr(i, close == std::string::npos ? std::string::npos : close - i + 1)));
+    result += shell_quote(value->string());
+    i = close + 1;
+  }
+  return result;
+}
+
+struct ExternalVoStage::Export {
+  ExternalVoOptions options;
+  fs::path folder, root;
+  dataset::ExportCalibration calibration;
+  std::unique_ptr<dataset::DatasetWriter> writer;
+  Trajectory truth;  // the left camera at each exported frame
+  std::vector<TimeNs> stamps;
+
+  // The folder the command is told about as {dir}.
+  fs::path dir() const {
+    return options.format == dataset::DatasetFormat::kKitti
+               ? root / "sequences" / calibration.sequence
+               : root;
+  }
+  fs::path out() const { return folder / ("trajectory." + extension(options.output)); }
+
+  // The command's trajectory as left-camera poses anchored at the true first pose.
+  Trajectory read_estimate() const {
+    Trajectory raw;
+    if (options.output == TrajectoryFormat::kKitti) {
+      KittiTiming timing;
+      timing.times_ns = stamps;
+      raw = read_kitti(out(), timing);
+    } else {
+      raw = read_trajectory(out(), options.output);
+    }
+    if (raw.empty()) throw UserError(out().string() + ": no poses");
+    if (options.output == TrajectoryFormat::kEuroc)  // body (IMU) poses
+      for (auto& p : raw) p.T_W_C = p.T_W_C * calibration.T_S_C;
+    const SE3 anchor = truth.front().T_W_C * raw.front().T_W_C.inverse();
+    for (auto& p : raw) p.T_W_C = anchor * p.T_W_C;
+    return raw;
+  }
+};
+
+ExternalVoStage::ExternalVoStage(const Scenario& sc, const fs::path& run_dir)
+    : sc_(sc), run_dir_(run_dir) {
+  for (const auto& o : sc.pipeline.external_vo) {
+    auto e = std::make_unique<Export>();
+    e->options = o;
+    e->folder = run_dir / "external" / o.name;
+    e->root = e->folder / "dataset";
+    fs::create_directories(e->root);
+    write_file_atomic(e->root / "scenario.resolved.yaml", resolved_yaml(sc));
+    e->calibration = export_calibration(sc);
+    e->writer = dataset::make_writer(o.format, e->root, e->calibration);
+    exports_.push_back(std::move(e));
+  }
+}
+
+ExternalVoStage::~ExternalVoStage() = default;
+
+bool ExternalVoStage::empty() const { return exports_.empty(); }
+
+bool ExternalVoStage::wants_depth() const {
+  for (const auto& e : exports_)
+    if (e->writer->wants_depth()) return true;
+  return false;
+}
+
+void ExternalVoStage::add_frame(TimeNs stamp_ns, const sim::StereoImages& images,
+                                const StampedPose& truth) {
+  for (auto& e : exports_) {
+    e->writer->add_frame(stamp_ns, view(images.left), view(images.right),
+                         e->writer->wants_depth() ? view(images.depth_left) : cv::Mat());
+    e->truth.push_back(truth);
+    e->stamps.push_back(stamp_ns);
+  }
+}
+
+std::vector<ExternalVoResult> ExternalVoStage::finish(
+    const std::vector<dataset::BodyState>& imu_states) {
+  std::vector<ExternalVoResult> results;
+  const fs::path self = fs::read_symlink("/proc/self/exe");
+  for (auto& e : exports_) {
+    ExternalVoResult r;
+    r.name = e->options.name;
+    dataset::ExportTruth truth;
+    truth.camera = e->truth;
+    truth.body = imu_states;
+    const fs::path staging = e->folder / ".sensors";
+    fs::create_directories(staging);
+    for (const char* csv : {"imu.csv", "gps.csv", "compass.csv"})
+      if (fs::exists(run_dir_ / csv)) {
+        fs::copy_file(run_dir_ / csv, staging / csv);
+        truth.sensor_csvs.push_back(staging / csv);
+      }
+    e->writer->finish(truth);
+    fs::remove_all(staging);
+    const std::string command =
+        expand_command(e->options.command, e->dir(), e->root, e->out(), self);
+    const Stopwatch watch;
+    const ExitStatus status =
+        run_with_timeout(command, e->options.timeout_s, e->folder / "log.txt");
+    r.record = {{"command", command},
+                {"format", dataset::format_name(e->options.format)},
+                {"output", format_name(e->options.output)},
+                {"exit", status.describe()},
+                {"seconds", watch.ms() / 1000},
+                {"frames", e->stamps.size()}};
+    if (status.exited && status.code == 124) {
+      r.record["status"] = "timeout";
+      r.warning = fmt::format("external VO '{}': no result within timeout_s = {} s", r.name,
+                              e->options.timeout_s);
+    } else if (!status.ok()) {
+      r.record["status"] = "failed";
+      r.warning =
+          fmt::format("external VO '{}': the command failed ({})", r.name, status.describe());
+    } else {
+      try {
+        r.estimate = e->read_estimate();
+        r.ok = true;
+        r.record["status"] = "ok";
+        const auto angle = heading_disagreement_deg(r.estimate, e->truth, 1.0);
+        if (angle && *angle > 45)
+          r.warning = fmt::format(
+              "external VO '{}': its first metre of motion points {:.0f} deg away from the left "
+              "camera's; is {} a left-camera trajectory (x right, y down, z forward)?",
+              r.name, *angle, e->out().filename().string());
+      } catch (const UserError& err) {
+        r.record["status"] = "bad output";
+        r.warning =
+            fmt::format("external VO '{}': its trajectory cannot be read: {}", r.name, err.what());
+      }
+    }
+    r.record["message"] = r.warning;
+    r.record["log_tail"] = log_tail(e->folder / "log.txt");
+    if (!e->options.keep_dataset) fs::remove_all(e->root);
+    results.push_back(std::move(r));
+  }
+  return results;
+}
+
+}  // namespace driftlab::pipeline

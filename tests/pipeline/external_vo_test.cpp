@@ -1,0 +1,118 @@
+// External VOs in a run: a real VO behind a command gives the built-in estimate; a command
+// that fails, hangs or writes garbage is recorded and the run keeps its other results.
+#include "pipeline/external_vo.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "core/trajectory_io.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace driftlab::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+using test::slurp;
+
+std::string script(const std::string& name) {
+  return "sh " + (test::source_dir() / "tests/data/external_vo" / name).string();
+}
+
+TEST(ExternalVo, CommandPlaceholdersAreQuotedAndUnknownOnesRejected) {
+  EXPECT_EQ(expand_command("myvo --calib {dir}/calib.txt {dir} > {out}", "/d/it's", "/r", "/o",
+                           "/bin/driftlab"),
+            "myvo --calib '/d/it'\\''s'/calib.txt '/d/it'\\''s' > '/o'");
+  EXPECT_EQ(expand_command("{driftlab} vo {root}", "/d", "/r", "/o", "/x"), "'/x' vo '/r'");
+  try {
+    expand_command("myvo {calib}", "/d", "/r", "/o", "/x");
+    FAIL() << "no error";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("got '{calib}', expected placeholders"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ExternalVo, NamesMustBeNewUniqueAndFileSafe) {
+  const auto error_of = [](const std::string& list) {
+    try {
+      parse_scenario("name: x\npipeline: {external_vo: " + list + "}\n", "t.yaml", ".");
+    } catch (const UserError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(error_of("[{name: sparse, command: a}]").find("got 'sparse', a built-in VO's name"),
+            std::string::npos);
+  EXPECT_NE(error_of("[{name: a, command: x}, {name: a, command: y}]").find("got 'a' twice"),
+            std::string::npos);
+  EXPECT_NE(error_of("[{name: 'a/b', command: x}]").find("letters, digits"), std::string::npos);
+  EXPECT_NE(error_of("[{name: a, command: x, output: ply}]").find("expected one of: tum, kitti"),
+            std::string::npos);
+  EXPECT_NE(error_of("[{name: a, command: x, timeout_s: 0}]").find("timeout_s"), std::string::npos);
+  EXPECT_EQ(error_of("[{name: my-vo_2, command: x, format: euroc, output: euroc}]"), "(no error)");
+}
+
+double largest_difference(const Trajectory& a, const Trajectory& b) {
+  EXPECT_EQ(a.size(), b.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    EXPECT_EQ(a[i].t_ns, b[i].t_ns);
+    worst = std::max(worst, (a[i].T_W_C.inverse() * b[i].T_W_C).log().norm());
+  }
+  return worst;
+}
+
+TEST(ExternalVo, RealFailingHangingAndGarbageCommandsAreEachRecorded) {
+  const fs::path out = test::unused_temp_path("external_vo_run");
+  const std::string list =
+      "[{name: mine, command: '" + script("driftlab_sparse.sh") +
+      " {driftlab} {dir} {root} {out}'}, {name: broken, command: '" + script("exit1.sh") +
+      " {dir}'}, {name: stuck, command: '" + script("hang.sh") +
+      "', timeout_s: 1}, {name: junk, command: '" + script("garbage.sh") +
+      " {out}'}, {name: mine_euroc, format: euroc, output: tum, command: 'test -f "
+      "{dir}/mav0/imu0/data.csv && test -f {dir}/mav0/state_groundtruth_estimate0/data.csv && "
+      "cp {root}/../../mine/trajectory.tum {out}'}]";
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto r = test::run_cli(
+      {"run", (test::source_dir() / "scenarios/river_crossing.yaml").string(), "--set",
+       "pipeline.max_frames=20", "--set", "pipeline.external_vo=" + list, "--out", out.string()});
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_LT(seconds, 60);  // the hanging command was killed at its 1 s limit
+  const auto m = nlohmann::json::parse(slurp(out / "metrics.json"));
+  const auto& ext = m["external_vo"];
+  EXPECT_EQ(ext["mine"]["status"], "ok");
+  EXPECT_EQ(ext["mine_euroc"]["status"], "ok");  // a EuRoC export with IMU and ground truth
+  EXPECT_EQ(ext["broken"]["status"], "failed");
+  EXPECT_EQ(ext["broken"]["exit"], "exit code 1");
+  EXPECT_NE(ext["broken"]["log_tail"].get<std::string>().find("permission denied"),
+            std::string::npos);
+  EXPECT_EQ(ext["stuck"]["status"], "timeout");
+  EXPECT_EQ(ext["junk"]["status"], "bad output");
+  EXPECT_NE(ext["junk"]["message"].get<std::string>().find("expected 8 columns"),
+            std::string::npos);
+  const std::string warnings = m["warnings"].dump();
+  for (const char* name : {"'broken'", "'stuck'", "'junk'"})
+    EXPECT_NE(warnings.find(name), std::string::npos) << name;
+  // The real VO behind the command is driftlab's sparse VO on the export: the built-in estimate.
+  EXPECT_TRUE(m["algorithms"].contains("mine"));
+  EXPECT_TRUE(m["algorithms"].contains("sparse"));
+  EXPECT_FALSE(m["algorithms"].contains("broken"));
+  EXPECT_LT(largest_difference(read_tum(out / "estimates/mine.tum"),
+                               read_tum(out / "estimates/sparse.tum")),
+            1e-9);
+  EXPECT_NE(slurp(out / "report.md").find("| stuck | timeout | exit code 124 |"),
+            std::string::npos);
+  // The datasets are removed after the commands (keep_dataset: false); the logs stay.
+  EXPECT_FALSE(fs::exists(out / "external/mine/dataset"));
+  EXPECT_TRUE(fs::exists(out / "external/broken/log.txt"));
+  fs::remove_all(out);
+}
+
+}  // namespace
+}  // namespace driftlab::pipeline
