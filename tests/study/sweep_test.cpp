@@ -670,5 +670,38 @@ TEST(SweepCli, OneLocalRunnerAtATime) {
   fs::remove_all(dir);
 }
 
+TEST(SweepCli, BuiltInAndExternalVoSideBySideMergeIntoOneTable) {
+  // Issue 17: an external VO (here driftlab's own sparse VO behind a command) in every job.
+  const fs::path root = temp_dir("external");
+  fs::create_directories(root);
+  const std::string script = (kSource / "tests/data/external_vo/driftlab_sparse.sh").string();
+  std::ofstream(root / "sweep.yaml")
+      << "name: tiny_external\nbase: " << (kSweeps / "tiny_base.yaml").string()
+      << "\nseed: 3\ndesign: grid\nset:\n  pipeline.fusion: []\n  pipeline.external_vo: "
+         "[{name: mine, command: 'sh "
+      << script
+      << " {driftlab} {dir} {root} {out}'}]\naxes:\n  - key: mission.yaw_weave.amplitude_deg\n"
+         "    name: yaw_amp_deg\n    values: [0, 20]\n";
+  Result r =
+      run_cli({"sweep", "plan", (root / "sweep.yaml").string(), "--out", (root / "plan").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = run_cli({"sweep", "run", (root / "plan").string(), "-j", "1"});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = run_cli({"sweep", "merge", (root / "plan").string(), "--no-plots"});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const std::string runs = slurp(root / "plan" / "summary" / "runs.csv");
+  std::istringstream lines(runs);
+  std::string line;
+  std::getline(lines, line);
+  std::size_t sparse = 0, mine = 0;
+  while (std::getline(lines, line)) {
+    sparse += line.find(",sparse,") != std::string::npos ? 1 : 0;
+    mine += line.find(",mine,") != std::string::npos ? 1 : 0;
+  }
+  EXPECT_EQ(sparse, 2u) << runs;
+  EXPECT_EQ(mine, 2u) << runs;
+  fs::remove_all(root);
+}
+
 }  // namespace
 }  // namespace driftlab::study
