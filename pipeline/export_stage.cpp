@@ -15,18 +15,7 @@
 namespace driftlab::pipeline {
 namespace fs = std::filesystem;
 
-namespace {
-
-cv::Mat view(const sim::GrayImage& img) {
-  return cv::Mat(img.height, img.width, CV_8UC1, const_cast<std::uint8_t*>(img.pixels.data()));
-}
-
-cv::Mat view(const sim::DepthImage& d) {
-  if (d.depth_m.empty()) return {};
-  return cv::Mat(d.height, d.width, CV_32FC1, const_cast<float*>(d.depth_m.data()));
-}
-
-}  // namespace
+namespace {}  // namespace
 
 std::string ExportSummary::brief() const {
   return fmt::format(
@@ -85,8 +74,8 @@ ExportSummary export_dataset(const Scenario& sc, const fs::path& out_dir,
   while (std::optional<CapturedFrame> f = source.next()) {
     progress.update(f->k);
     render_s += f->render_ms / 1000;
-    writer->add_frame(stamps[f->k].t_stamp_ns, view(f->images.left), view(f->images.right),
-                      view(f->images.depth_left));
+    writer->add_frame(stamps[f->k].t_stamp_ns, cv_view(f->images.left), cv_view(f->images.right),
+                      cv_view(f->images.depth_left));
     truth.camera.push_back(mission.camera_gt[f->k]);
     ++summary.frames;
   }

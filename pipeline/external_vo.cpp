@@ -11,6 +11,7 @@
 #include "core/process.hpp"
 #include "core/stopwatch.hpp"
 #include "pipeline/export_stage.hpp"
+#include "pipeline/frame_source.hpp"
 
 namespace driftlab::pipeline {
 namespace fs = std::filesystem;
@@ -36,15 +37,6 @@ std::string extension(TrajectoryFormat f) {
       return "csv";
   }
   return "txt";
-}
-
-cv::Mat view(const sim::GrayImage& img) {
-  return cv::Mat(img.height, img.width, CV_8UC1, const_cast<std::uint8_t*>(img.pixels.data()));
-}
-
-cv::Mat view(const sim::DepthImage& d) {
-  if (d.depth_m.empty()) return {};
-  return cv::Mat(d.height, d.width, CV_32FC1, const_cast<float*>(d.depth_m.data()));
 }
 
 // Runs `command` under coreutils' timeout, which kills its whole process group at the limit.
@@ -164,8 +156,8 @@ bool ExternalVoStage::wants_depth() const {
 void ExternalVoStage::add_frame(TimeNs stamp_ns, const sim::StereoImages& images,
                                 const StampedPose& truth) {
   for (auto& e : exports_) {
-    e->writer->add_frame(stamp_ns, view(images.left), view(images.right),
-                         e->writer->wants_depth() ? view(images.depth_left) : cv::Mat());
+    e->writer->add_frame(stamp_ns, cv_view(images.left), cv_view(images.right),
+                         e->writer->wants_depth() ? cv_view(images.depth_left) : cv::Mat());
     e->truth.push_back(truth);
     e->stamps.push_back(stamp_ns);
   }

@@ -16,6 +16,15 @@
 
 namespace driftlab::pipeline {
 
+cv::Mat cv_view(const sim::GrayImage& img) {
+  return cv::Mat(img.height, img.width, CV_8UC1, const_cast<std::uint8_t*>(img.pixels.data()));
+}
+
+cv::Mat cv_view(const sim::DepthImage& d) {
+  if (d.depth_m.empty()) return {};
+  return cv::Mat(d.height, d.width, CV_32FC1, const_cast<float*>(d.depth_m.data()));
+}
+
 int run_threads(int requested) {
   if (requested > 0) return requested;
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 #include "pipeline/camera_stage.hpp"
 #include "pipeline/scenario.hpp"
 #include "sim/render/scene_geometry.hpp"
@@ -54,6 +56,11 @@ class FrameSource {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// OpenCV views (no copy) of a frame's images, valid while the image lives; an empty depth
+/// image gives an empty matrix.
+cv::Mat cv_view(const sim::GrayImage& image);
+cv::Mat cv_view(const sim::DepthImage& depth);
 
 /// The threads a run uses: `requested`, or every core when it is 0.
 int run_threads(int requested);

@@ -266,10 +266,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
     const sim::StereoImages& img = captured->images;
     vo::StereoFrame frame;
     frame.t_ns = t;
-    frame.left = cv::Mat(img.left.height, img.left.width, CV_8UC1,
-                         const_cast<std::uint8_t*>(img.left.pixels.data()));
-    frame.right = cv::Mat(img.right.height, img.right.width, CV_8UC1,
-                          const_cast<std::uint8_t*>(img.right.pixels.data()));
+    frame.left = cv_view(img.left);
+    frame.right = cv_view(img.right);
     std::string row = fmt::format("{},{},{},{},{:.3f},{}", t, rad2deg(platform[k].yaw_rad),
                                   rad2deg(platform[k].pitch_rad), rad2deg(platform[k].roll_rad),
                                   render_ms, yaml::format_double(exposure_ms));
