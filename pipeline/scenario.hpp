@@ -81,7 +81,7 @@ struct ExternalVoOptions {
       yaml::positive());
     a("keep_dataset", keep_dataset,
       "Keep the exported frames in external/NAME/ after the command (they are large: about "
-      "0.5 MB per stereo pair at 640x480)");
+      "0.3 MB per stereo pair at 640x480)");
   }
 };
 
