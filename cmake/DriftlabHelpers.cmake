@@ -20,20 +20,25 @@ function(driftlab_module)
     add_library(${target} STATIC ${M_SOURCES})
     # No fused multiply-add contraction: same bytes out on every x86-64 CPU.
     target_compile_options(${target} PRIVATE -ffp-contract=off)
-    target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR})
+    target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+                                                $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
     driftlab_warnings(${target})
     if(M_DEPS)
       target_link_libraries(${target} ${M_DEPS})
     endif()
   else()
     add_library(${target} INTERFACE)
-    target_include_directories(${target} INTERFACE ${PROJECT_SOURCE_DIR})
+    target_include_directories(${target} INTERFACE $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+                                                   $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
     if(M_DEPS)
       string(REPLACE "PUBLIC" "INTERFACE" deps "${M_DEPS}")
       list(FILTER deps EXCLUDE REGEX "^PRIVATE$")
       target_link_libraries(${target} ${deps})
     endif()
   endif()
+  # Installed as driftlab::<name> too (find_package(driftlab), see cmake/driftlabConfig.cmake.in).
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${M_NAME})
+  set_property(GLOBAL APPEND PROPERTY DRIFTLAB_MODULES ${target})
   add_library(driftlab::${M_NAME} ALIAS ${target})
 endfunction()
 

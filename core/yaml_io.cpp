@@ -28,6 +28,7 @@ Check Check::operator&(const Check& o) const {
   c.min_size = std::max(c.min_size, o.min_size);
   c.max_size = std::min(c.max_size, o.max_size);
   c.non_empty_string = c.non_empty_string || o.non_empty_string;
+  if (o.choices) c.choices = o.choices;
   return c;
 }
 
@@ -56,9 +57,23 @@ std::string Check::describe() const {
   } else if (has_max) {
     parts.push_back(fmt::format("at most {}", max_size));
   }
+  if (choices) {
+    std::string names;
+    for (const auto& n : choices()) names += (names.empty() ? "" : ", ") + n;
+    parts.push_back("each one of: " + names);
+  }
   std::string out;
   for (const auto& p : parts) out += (out.empty() ? "" : ", ") + p;
   return out;
+}
+
+std::string unknown_choice(const Check& check, const std::string& name) {
+  if (!check.choices) return "";
+  const std::vector<std::string> names = check.choices();
+  if (std::find(names.begin(), names.end(), name) != names.end()) return "";
+  std::string list;
+  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+  return "one of: " + list;
 }
 
 // ---------------------------------------------------------------------------

@@ -27,6 +27,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -52,6 +53,9 @@ struct Check {
   std::size_t min_size = 0;
   std::size_t max_size = std::numeric_limits<std::size_t>::max();
   bool non_empty_string = false;
+  /// Strings (and the strings of a list) must be one of these names, asked for when the
+  /// value is checked: a list that grows at run time (e.g. the VOs a program registers).
+  std::function<std::vector<std::string>()> choices{};
 
   /// Combine two checks (both must hold).
   Check operator&(const Check& o) const;
@@ -73,6 +77,11 @@ inline Check size_between(std::size_t lo, std::size_t hi) {
   return {.min_size = lo, .max_size = hi};
 }
 inline Check non_empty() { return {.min_size = 1, .non_empty_string = true}; }
+inline Check one_of(std::function<std::vector<std::string>()> names) {
+  return {.choices = std::move(names)};
+}
+/// "one of: a, b, c" when `name` is not among check.choices(); empty when it is (or no choices).
+std::string unknown_choice(const Check& check, const std::string& name);
 
 // ---------------------------------------------------------------------------
 // Type traits.
@@ -288,6 +297,10 @@ void Reader::read_value(const YAML::Node& node, const std::string& key_path, T& 
       fail(node, key_path, "an empty string", "a non-empty string");
       return;
     }
+    if (const std::string expected = unknown_choice(check, text); !expected.empty()) {
+      fail(node, key_path, "'" + text + "'", expected);
+      return;
+    }
     value = text;
   } else if constexpr (Enum<T>) {
     const std::string expected = "one of: " + enum_choices<T>();
@@ -492,6 +505,8 @@ void Validator::check_value(const std::string& key_path, const T& value, const C
   } else if constexpr (std::is_same_v<T, std::string>) {
     if (check.non_empty_string && value.empty())
       errors_->add(key_path + ": got an empty string, expected a non-empty string");
+    else if (const std::string expected = unknown_choice(check, value); !expected.empty())
+      errors_->add(key_path + ": got '" + value + "', expected " + expected);
   } else if constexpr (is_std_vector<T>::value || is_std_array<T>::value) {
     if (value.size() < check.min_size || value.size() > check.max_size) {
       Check size_only{.min_size = check.min_size, .max_size = check.max_size};

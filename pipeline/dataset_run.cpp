@@ -22,7 +22,6 @@ namespace fs = std::filesystem;
 namespace {
 
 struct VoTrack {
-  VoAlgorithm algorithm;
   std::string name;
   std::unique_ptr<vo::StereoOdometry> vo;
   Trajectory estimate;
@@ -48,7 +47,7 @@ eval::FrameTable covariates(const VoTrack& t, const std::vector<dataset::Dataset
     const vo::VoResult& r = t.results[k];
     ft.t_ns.push_back(frames[k].t_ns);
     // Covariate f: inlier features (sparse, river paper Table 4), pixels with depth (dense).
-    const double f = t.algorithm == VoAlgorithm::kDense ? r.valid_depth_pixels : r.inliers;
+    const double f = t.name == "dense" ? r.valid_depth_pixels : r.inliers;
     ft.columns[0].push_back(r.valid ? f : nan);
     ft.columns[1].push_back(r.valid ? r.mean_inlier_depth_m : nan);
   }
@@ -70,9 +69,9 @@ DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario
   write_file_atomic(dir.path() / "scenario.resolved.yaml", resolved_yaml(settings));
   const RngStreams rng(settings.seed);
   std::vector<VoTrack> tracks;
-  for (VoAlgorithm a : options.algorithms.empty() ? settings.pipeline.vo : options.algorithms)
-    tracks.push_back(
-        {a, std::string(yaml::enum_name(a)), make_vo(a, d.rig, settings.pipeline, rng), {}, {}, 0});
+  for (const std::string& a :
+       options.algorithms.empty() ? settings.pipeline.vo : options.algorithms)
+    tracks.push_back({a, make_vo(a, d.rig, settings.pipeline, rng), {}, {}, 0});
   if (tracks.empty()) throw UserError("driftlab vo: no VO to run (--algo or pipeline.vo)");
   const auto [first, T_W_C0] = first_anchored(d);
   std::size_t end = d.frames.size();

@@ -13,7 +13,7 @@
 namespace driftlab::pipeline {
 
 struct DatasetRunOptions {
-  std::vector<VoAlgorithm> algorithms;  ///< empty: the settings' pipeline.vo
+  std::vector<std::string> algorithms;  ///< empty: the settings' pipeline.vo
   std::size_t max_frames = 0;           ///< 0: every frame
   bool replace_existing = false;
   std::FILE* progress = nullptr;

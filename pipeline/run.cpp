@@ -209,16 +209,10 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   // anchors every estimate at the true first pose so that tracks overlay.
   std::vector<Track> tracks;
   std::vector<std::string> warnings;
-  for (VoAlgorithm a : sc.pipeline.vo) {
-    auto v = make_vo(a, rig, sc.pipeline, rng);
-    if (!v) {
-      warnings.push_back(
-          fmt::format("pipeline.vo: '{}' is not in this build yet; skipped", yaml::enum_name(a)));
-      continue;
-    }
+  for (const std::string& a : sc.pipeline.vo) {
     Track t;
-    t.name = std::string(yaml::enum_name(a));
-    t.vo = std::move(v);
+    t.name = a;
+    t.vo = make_vo(a, rig, sc.pipeline, rng);
     t.results.resize(camera_gt.size());
     for (auto& r : t.results) r.reason = "frame dropped";
     tracks.push_back(std::move(t));
@@ -347,7 +341,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
       const vo::VoResult& r = src.results[k];
       // Covariate f: inlier features (sparse, river paper Table 4), pixels with valid depth
       // (dense).
-      const double f = tr.name.rfind("dense", 0) == 0 ? r.valid_depth_pixels : r.inliers;
+      const double f = src.name == "dense" ? r.valid_depth_pixels : r.inliers;
       ft.columns[3].push_back(r.valid ? f : std::numeric_limits<double>::quiet_NaN());
       ft.columns[4].push_back(r.valid ? r.mean_inlier_depth_m
                                       : std::numeric_limits<double>::quiet_NaN());

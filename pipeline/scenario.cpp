@@ -113,7 +113,8 @@ void validate_scenario(const Scenario& s, const std::string& label) {
   for (const auto& e : s.pipeline.external_vo) {
     constexpr std::string_view kNameChars =
         "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-";
-    if (yaml::enum_from_name<VoAlgorithm>(e.name))
+    const auto& built_in = vo::built_in_vo_names();
+    if (std::find(built_in.begin(), built_in.end(), e.name) != built_in.end())
       errors.add(fmt::format(
           "pipeline.external_vo: name: got '{}', a built-in VO's name, expected another name",
           e.name));

@@ -21,16 +21,10 @@
 #include "sim/waves/wave_options.hpp"
 #include "vo/dense/dense_options.hpp"
 #include "vo/pnp/pnp_options.hpp"
+#include "vo/registry.hpp"
 #include "vo/sparse/sparse_options.hpp"
 
 namespace driftlab::pipeline {
-
-enum class VoAlgorithm { kSparse, kSparseKf, kPnp, kDense };
-constexpr auto enum_table(VoAlgorithm) {
-  return std::array{std::pair{VoAlgorithm::kSparse, "sparse"},
-                    std::pair{VoAlgorithm::kSparseKf, "sparse_kf"},
-                    std::pair{VoAlgorithm::kPnp, "pnp"}, std::pair{VoAlgorithm::kDense, "dense"}};
-}
 
 /// The options of sparse_kf: the sparse VO's, keyframes on.
 inline vo::SparseVoOptions sparse_kf_defaults() {
@@ -86,7 +80,7 @@ struct ExternalVoOptions {
 };
 
 struct PipelineOptions {
-  std::vector<VoAlgorithm> vo{VoAlgorithm::kSparse};
+  std::vector<std::string> vo{"sparse"};
   std::vector<FusionAlgorithm> fusion{FusionAlgorithm::kCaSmoother};
   std::vector<ExternalVoOptions> external_vo;
   int max_frames = 0;
@@ -103,7 +97,10 @@ struct PipelineOptions {
 
   template <class A>
   void visit(A& a) {
-    a("vo", vo, "Visual odometry algorithms to run");
+    a("vo", vo,
+      "Visual odometry algorithms to run: the built-in ones and any VO the program registered "
+      "(vo/registry.hpp)",
+      yaml::one_of(&vo::available_vo_names));
     a("fusion", fusion, "Filters and smoothers to run on the VO output");
     a("external_vo", external_vo,
       "VOs of your own, each a command run on an export of this run's frames and evaluated "

@@ -2,27 +2,27 @@
 
 #include <fmt/format.h>
 
+#include "core/error.hpp"
 #include "core/yaml_io.hpp"
 #include "vo/dense/dense_vo.hpp"
 #include "vo/pnp/pnp_vo.hpp"
+#include "vo/registry.hpp"
 #include "vo/sparse/sparse_vo.hpp"
 
 namespace driftlab::pipeline {
 
-std::unique_ptr<vo::StereoOdometry> make_vo(VoAlgorithm a, const StereoRig& rig,
+std::unique_ptr<vo::StereoOdometry> make_vo(const std::string& name, const StereoRig& rig,
                                             const PipelineOptions& p, const RngStreams& rng) {
-  switch (a) {
-    case VoAlgorithm::kSparse:
-      return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse, rng.stream("vo.sparse"));
-    case VoAlgorithm::kSparseKf:
-      return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse_kf,
-                                                        rng.stream("vo.sparse_kf"));
-    case VoAlgorithm::kPnp:
-      return std::make_unique<vo::PnpStereoOdometry>(rig, p.pnp, rng.stream("vo.pnp"));
-    case VoAlgorithm::kDense:
-      return std::make_unique<vo::DenseStereoOdometry>(rig, p.dense, rng.stream("vo.dense"));
-  }
-  return nullptr;
+  Rng stream = rng.stream("vo." + name);
+  if (name == "sparse") return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse, stream);
+  if (name == "sparse_kf")
+    return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse_kf, stream);
+  if (name == "pnp") return std::make_unique<vo::PnpStereoOdometry>(rig, p.pnp, stream);
+  if (name == "dense") return std::make_unique<vo::DenseStereoOdometry>(rig, p.dense, stream);
+  if (auto v = vo::make_registered_vo(name, rig, stream)) return v;
+  std::string names;
+  for (const auto& n : vo::available_vo_names()) names += (names.empty() ? "" : ", ") + n;
+  throw UserError(fmt::format("pipeline.vo: got '{}', expected one of: {}", name, names));
 }
 
 std::string vo_csv_header(const std::string& name) {

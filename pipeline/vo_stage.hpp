@@ -12,9 +12,10 @@
 
 namespace driftlab::pipeline {
 
-/// The VO `algorithm` on `rig` with its options from `pipeline` and its own random stream
-/// ("vo.<name>") of `rng`.
-std::unique_ptr<vo::StereoOdometry> make_vo(VoAlgorithm algorithm, const StereoRig& rig,
+/// The VO `name` (built-in, or registered: vo/registry.hpp) on `rig`, a built-in one with its
+/// options from `pipeline`, each with its own random stream ("vo.<name>") of `rng`. UserError
+/// for an unknown name.
+std::unique_ptr<vo::StereoOdometry> make_vo(const std::string& name, const StereoRig& rig,
                                             const PipelineOptions& pipeline, const RngStreams& rng);
 
 /// frames.csv columns of one VO: ",NAME_valid,NAME_inliers,NAME_valid_depth_px,

@@ -178,7 +178,7 @@ TEST(CameraStage, AutoExposureSettlesOnTheTargetMean) {
 TEST(CameraStage, RunStampsFramesWithTheCameraClockAndSkipsDroppedOnes) {
   Scenario sc = river();
   sc.pipeline.max_frames = 60;
-  sc.pipeline.vo = {VoAlgorithm::kSparse};
+  sc.pipeline.vo = {"sparse"};
   sc.pipeline.fusion = {};
   sc.sensors.camera.clock.offset_ms = 30;  // the river paper's mean camera offset
   sc.sensors.camera.clock.drop_probability = 0.2;

@@ -26,7 +26,7 @@ using test::slurp;
 Scenario short_crossing_with_drops() {
   Scenario s = load_scenario(test::source_dir() / "scenarios/river_crossing.yaml");
   s.pipeline.max_frames = 30;
-  s.pipeline.vo = {VoAlgorithm::kSparse, VoAlgorithm::kSparseKf};
+  s.pipeline.vo = {"sparse", "sparse_kf"};
   s.sensors.camera.clock.drop_probability = 0.1;
   return s;
 }

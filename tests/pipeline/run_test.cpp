@@ -118,7 +118,7 @@ TEST(Run, SameBytesWhateverTheThreadCount) {
   // dropped frames and a keyframe VO: the same estimates, tables and per-frame rows.
   const fs::path a = temp_dir("threads1"), b = temp_dir("threads2");
   Scenario sc = short_crossing(40);
-  sc.pipeline.vo = {VoAlgorithm::kSparse, VoAlgorithm::kSparseKf};
+  sc.pipeline.vo = {"sparse", "sparse_kf"};
   sc.sensors.camera.clock.drop_probability = 0.1;
   sc.pipeline.threads = 1;
   run_scenario(sc, a, {});
@@ -205,8 +205,7 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   const fs::path out = temp_dir("e2e");
   Scenario sc = load_scenario(kSource / "scenarios/river_crossing.yaml");
   ASSERT_EQ(sc.water.waves.model, sim::WaveModel::kCalm);
-  ASSERT_EQ(sc.pipeline.vo,
-            (std::vector<VoAlgorithm>{VoAlgorithm::kSparse, VoAlgorithm::kSparseKf}));
+  ASSERT_EQ(sc.pipeline.vo, (std::vector<std::string>{"sparse", "sparse_kf"}));
   sc.mission.type = sim::MissionType::kStraight;
   sc.mission.speed_mps = 0.5;
   sc.pipeline.max_frames = 420;

@@ -39,8 +39,7 @@ TEST(Scenario, LoadsTheDemoScenario) {
   EXPECT_DOUBLE_EQ(s.mission.crossings * s.mission.crossing_width_m, 54.0);
   EXPECT_DOUBLE_EQ(s.sensors.camera.baseline_m, 0.12);
   // The paper's frame-to-frame method and the keyframe variant.
-  EXPECT_EQ(s.pipeline.vo,
-            (std::vector<VoAlgorithm>{VoAlgorithm::kSparse, VoAlgorithm::kSparseKf}));
+  EXPECT_EQ(s.pipeline.vo, (std::vector<std::string>{"sparse", "sparse_kf"}));
   EXPECT_FALSE(s.pipeline.sparse.keyframes);
   EXPECT_TRUE(s.pipeline.sparse_kf.keyframes);
   EXPECT_DOUBLE_EQ(s.eval.section_length_m, 6.5);

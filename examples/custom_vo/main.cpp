@@ -1,0 +1,14 @@
+// my-driftlab: driftlab's command line with one more VO, "lk_pnp", registered before the
+// command line reads any scenario.
+#include <memory>
+
+#include "app/driftlab_main.hpp"
+#include "lk_pnp_vo.hpp"
+#include "vo/registry.hpp"
+
+int main(int argc, char** argv) {
+  driftlab::vo::register_vo("lk_pnp", [](const driftlab::StereoRig& rig, driftlab::Rng rng) {
+    return std::make_unique<LkPnpVo>(rig, rng);
+  });
+  return driftlab::app::driftlab_main(argc, argv);
+}
