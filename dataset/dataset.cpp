@@ -80,6 +80,16 @@ cv::Mat read_gray(const fs::path& path) {
   return gray;
 }
 
+std::pair<cv::Mat, cv::Mat> read_pair(const StereoDataset& data, const DatasetFrame& frame) {
+  cv::Mat left = read_gray(frame.left), right = read_gray(frame.right);
+  if (!data.rectification) return {left, right};
+  const Rectification& r = *data.rectification;
+  cv::Mat left_rect, right_rect;
+  cv::remap(left, left_rect, r.left_map1, r.left_map2, cv::INTER_LINEAR);
+  cv::remap(right, right_rect, r.right_map1, r.right_map2, cv::INTER_LINEAR);
+  return {left_rect, right_rect};
+}
+
 std::optional<SE3> pose_at(const Trajectory& trajectory, TimeNs t_ns) {
   if (trajectory.empty() || t_ns < trajectory.front().t_ns || t_ns > trajectory.back().t_ns)
     return std::nullopt;

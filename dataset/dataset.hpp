@@ -94,6 +94,11 @@ struct DatasetFrame {
   std::filesystem::path left, right;
 };
 
+/// Pixel maps (cv::remap) from raw images to the rectified pair of a StereoDataset's rig.
+struct Rectification {
+  cv::Mat left_map1, left_map2, right_map1, right_map2;
+};
+
 /// What a stereo VO needs from a dataset, and the ground truth to judge it by.
 struct StereoDataset {
   DatasetFormat format = DatasetFormat::kKitti;
@@ -102,7 +107,11 @@ struct StereoDataset {
   std::vector<DatasetFrame> frames;
   Trajectory camera_gt;  ///< left camera; empty when the dataset has none
   std::vector<ImuSample> imu;
-  SE3 T_S_C;  ///< left camera in the body frame (identity where unknown)
+  SE3 T_S_C;  ///< rectified left camera in the body frame (identity where unknown)
+  /// Set when the images are raw (EuRoC with lens distortion or a rotated right camera): the
+  /// pair is rectified as it is read (read_pair) with OpenCV's stereoRectify (zero disparity
+  /// at infinity, no black border: alpha 0).
+  std::shared_ptr<const Rectification> rectification;
 };
 
 struct ReadOptions {
@@ -116,6 +125,9 @@ StereoDataset read_dataset(const std::filesystem::path& root, DatasetFormat form
 
 /// An 8-bit gray image (colour is converted); UserError naming the file when it cannot be read.
 cv::Mat read_gray(const std::filesystem::path& path);
+
+/// The stereo pair of `frame` as the VOs take it: 8-bit gray, rectified for `data.rig`.
+std::pair<cv::Mat, cv::Mat> read_pair(const StereoDataset& data, const DatasetFrame& frame);
 
 /// The pose of `trajectory` (sorted) at time t: interpolated between the neighbours
 /// (SE3::interpolate_decoupled), or nothing outside its time span.

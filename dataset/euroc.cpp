@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <opencv2/calib3d.hpp>
+
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
@@ -131,6 +133,7 @@ class EurocWriter final : public DatasetWriter {
 
 struct CameraYaml {
   PinholeCamera camera;
+  std::string distortion_model;
   std::vector<double> distortion;
   SE3 T_B_C;
 };
@@ -171,6 +174,14 @@ CameraYaml read_camera_yaml(const fs::path& path) {
   c.camera.height = static_cast<int>(res[1]);
   if (root["distortion_coefficients"])
     c.distortion = yaml_numbers(root, "distortion_coefficients", 0, path);
+  if (root["distortion_model"]) c.distortion_model = root["distortion_model"].as<std::string>();
+  const bool radtan = c.distortion_model.empty() || c.distortion_model == "radial-tangential" ||
+                      c.distortion_model == "radtan";
+  if (!radtan || (c.distortion.size() != 0 && c.distortion.size() != 4 && c.distortion.size() != 5))
+    throw UserError(fmt::format(
+        "{}: distortion_model: got '{}' with {} coefficients, expected radial-tangential with 4 "
+        "(k1, k2, p1, p2) or 5",
+        path.string(), c.distortion_model, c.distortion.size()));
   const auto t = yaml_numbers(root["T_BS"] ? root["T_BS"] : YAML::Node(), "data", 16, path);
   Mat3 R;
   R << t[0], t[1], t[2], t[4], t[5], t[6], t[8], t[9], t[10];
@@ -200,8 +211,9 @@ std::vector<std::pair<TimeNs, std::string>> read_camera_index(const fs::path& pa
   return out;
 }
 
-// The pair must already be rectified: the VOs take a pinhole rig with a pure x baseline.
-StereoRig rectified_rig(const CameraYaml& c0, const CameraYaml& c1, const fs::path& cam1_yaml) {
+// Whether the pair is already what the VOs take: equal pinholes, no distortion, the right
+// camera moved along the left one's x axis only.
+bool already_rectified(const CameraYaml& c0, const CameraYaml& c1) {
   const SE3 T_C0_C1 = c0.T_B_C.inverse() * c1.T_B_C;
   const double baseline = T_C0_C1.translation().x();
   bool rectified = baseline > 0 && std::abs(T_C0_C1.translation().y()) < 1e-6 * baseline &&
@@ -210,19 +222,64 @@ StereoRig rectified_rig(const CameraYaml& c0, const CameraYaml& c1, const fs::pa
   for (const auto* c : {&c0, &c1})
     for (double d : c->distortion) rectified = rectified && d == 0;
   const PinholeCamera &a = c0.camera, &b = c1.camera;
-  rectified = rectified && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy &&
-              a.width == b.width && a.height == b.height;
-  if (!rectified)
-    throw UserError(fmt::format(
-        "{}: cam0 and cam1 are not a rectified pair (expected equal pinhole intrinsics, zero "
-        "distortion and cam1 = cam0 moved along its x axis only); driftlab vo does not rectify "
-        "raw EuRoC images yet: rectify them first (e.g. cv::stereoRectify) and write the "
-        "rectified calibration",
-        cam1_yaml.string()));
+  return rectified && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy &&
+         a.width == b.width && a.height == b.height;
+}
+
+cv::Matx33d camera_matrix(const PinholeCamera& c) {
+  return {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1};
+}
+
+struct RectifiedPair {
   StereoRig rig;
-  rig.camera = a;
-  rig.baseline_m = baseline;
-  return rig;
+  SE3 T_C0_Crect;  // the rectified left camera in the raw left one (a rotation)
+  std::shared_ptr<const Rectification> rectification;  // null: already rectified
+};
+
+RectifiedPair rectify_pair(const CameraYaml& c0, const CameraYaml& c1, const fs::path& cam1_yaml) {
+  RectifiedPair out;
+  if (already_rectified(c0, c1)) {
+    out.rig.camera = c0.camera;
+    out.rig.baseline_m = (c0.T_B_C.inverse() * c1.T_B_C).translation().x();
+    return out;
+  }
+  const cv::Size size(c0.camera.width, c0.camera.height);
+  if (c1.camera.width != size.width || c1.camera.height != size.height)
+    throw UserError(fmt::format("{}: resolution: got {}x{}, expected cam0's {}x{}",
+                                cam1_yaml.string(), c1.camera.width, c1.camera.height, size.width,
+                                size.height));
+  // x_c1 = R x_c0 + T, OpenCV's convention for the pair.
+  const SE3 T_C1_C0 = c1.T_B_C.inverse() * c0.T_B_C;
+  cv::Matx33d R;
+  const Mat3 Re = T_C1_C0.rotation();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R(i, j) = Re(i, j);
+  const Vec3 te = T_C1_C0.translation();
+  const cv::Vec3d T(te.x(), te.y(), te.z());
+  cv::Mat R1, R2, P1, P2, Q;
+  cv::stereoRectify(camera_matrix(c0.camera), c0.distortion, camera_matrix(c1.camera),
+                    c1.distortion, size, R, T, R1, R2, P1, P2, Q, cv::CALIB_ZERO_DISPARITY, 0,
+                    size);
+  const double baseline = -P2.at<double>(0, 3) / P2.at<double>(0, 0);
+  if (!(baseline > 0))
+    throw UserError(
+        fmt::format("{}: T_BS: cam1 is not to the right of cam0 (rectified "
+                    "baseline {} m), expected the right camera as cam1",
+                    cam1_yaml.string(), baseline));
+  auto maps = std::make_shared<Rectification>();
+  cv::initUndistortRectifyMap(camera_matrix(c0.camera), c0.distortion, R1, P1, size, CV_16SC2,
+                              maps->left_map1, maps->left_map2);
+  cv::initUndistortRectifyMap(camera_matrix(c1.camera), c1.distortion, R2, P2, size, CV_16SC2,
+                              maps->right_map1, maps->right_map2);
+  out.rectification = maps;
+  out.rig.camera = {P1.at<double>(0, 0), P1.at<double>(1, 1), P1.at<double>(0, 2),
+                    P1.at<double>(1, 2), size.width,          size.height};
+  out.rig.baseline_m = baseline;
+  Mat3 R1e;  // x_rect = R1 x_c0
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R1e(i, j) = R1.at<double>(i, j);
+  out.T_C0_Crect = SE3(Mat3(R1e.transpose()), Vec3::Zero());
+  return out;
 }
 
 }  // namespace
@@ -239,8 +296,10 @@ StereoDataset read_euroc(const fs::path& root) {
   d.root = root;
   const CameraYaml c0 = read_camera_yaml(mav / "cam0" / "sensor.yaml");
   const CameraYaml c1 = read_camera_yaml(mav / "cam1" / "sensor.yaml");
-  d.rig = rectified_rig(c0, c1, mav / "cam1" / "sensor.yaml");
-  d.T_S_C = c0.T_B_C;
+  const RectifiedPair pair = rectify_pair(c0, c1, mav / "cam1" / "sensor.yaml");
+  d.rig = pair.rig;
+  d.rectification = pair.rectification;
+  d.T_S_C = c0.T_B_C * pair.T_C0_Crect;
   const auto left = read_camera_index(mav / "cam0" / "data.csv");
   const auto right = read_camera_index(mav / "cam1" / "data.csv");
   std::size_t j = 0;  // pairs: the stamps both cameras have

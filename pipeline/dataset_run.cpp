@@ -85,8 +85,8 @@ DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario
   Progress progress(options.progress, "vo", used.size(), options.progress_tty);
   for (std::size_t k = 0; k < used.size(); ++k) {
     progress.update(k);
-    vo::StereoFrame frame{used[k].t_ns, dataset::read_gray(used[k].left),
-                          dataset::read_gray(used[k].right)};
+    auto [left, right] = dataset::read_pair(d, used[k]);  // rectified when raw
+    vo::StereoFrame frame{used[k].t_ns, left, right};
     std::string row = std::to_string(frame.t_ns);
     for (auto& t : tracks) {
       const vo::VoResult r = t.vo->process(frame);

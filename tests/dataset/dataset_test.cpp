@@ -5,12 +5,17 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <fmt/format.h>
+
 #include <fstream>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "core/error.hpp"
 #include "core/rotation.hpp"
+#include "dataset/dataset_detail.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace driftlab::dataset {
@@ -233,16 +238,19 @@ TEST(DatasetReaders, NameTheFileLineAndExpectation) {
   e = error_of([] { format_from_name("rosbag"); });
   EXPECT_NE(e.find("got 'rosbag', expected one of: kitti, euroc, tum-rgbd"), std::string::npos);
 
-  // EuRoC: a raw (distorted) pair is refused with what to do; a bad stamp names its line.
+  // EuRoC: a lens model other than radial-tangential is refused; a bad stamp names its line.
   const fs::path eu = test::fresh_temp_dir("dataset_errors_euroc");
   Sequence{}.write(*make_writer(DatasetFormat::kEuroc, eu, calibration()));
   const fs::path cam1 = eu / "mav0" / "cam1" / "sensor.yaml";
   const std::string good_yaml = slurp(cam1);
   std::string yaml = good_yaml;
-  yaml.replace(yaml.find("[0.0, 0.0, 0.0, 0.0]"), 20, "[-0.28, 0.07, 0.0002, 0.00002]");
+  yaml.replace(yaml.find("radial-tangential"), 17, "equidistant");
   std::ofstream(cam1) << yaml;
   e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
-  EXPECT_NE(e.find("not a rectified pair"), std::string::npos) << e;
+  EXPECT_NE(e.find("distortion_model: got 'equidistant' with 4 coefficients, expected "
+                   "radial-tangential"),
+            std::string::npos)
+      << e;
   std::ofstream(cam1) << good_yaml;
   std::ofstream(eu / "mav0" / "cam0" / "data.csv") << "#timestamp [ns],filename\n12x,a.png\n";
   e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
@@ -258,6 +266,83 @@ TEST(PoseAt, InterpolatesBetweenNeighboursAndNothingOutside) {
   EXPECT_EQ(pose_at(t, 10)->translation(), Vec3(1, 2, 0));
   EXPECT_FALSE(pose_at(t, 11).has_value());
   EXPECT_FALSE(pose_at(t, -1).has_value());
+}
+
+}  // namespace
+}  // namespace driftlab::dataset
+
+namespace driftlab::dataset {
+namespace {
+
+// A raw EuRoC pair (lens distortion, the right camera turned by 1 deg): rectified as it is
+// read. Each point's rectified pixels, followed through the maps back into the raw images,
+// land where OpenCV's own distorted projection puts it, and the rectified rows agree.
+TEST(EurocRaw, IsRectifiedWhenReadWithTheRigAndPosesOfTheRectifiedPair) {
+  const fs::path root = test::fresh_temp_dir("euroc_raw");
+  ExportCalibration cal = calibration();
+  cal.rig.camera = {458.7, 457.3, 367.2, 248.4, 752, 480};  // EuRoC-like
+  cal.rig.baseline_m = 0.11;
+  Sequence seq;
+  seq.left.assign(3, cv::Mat(480, 752, CV_8UC1, cv::Scalar(0)));
+  seq.right = seq.left;
+  seq.write(*make_writer(DatasetFormat::kEuroc, root, cal));
+  const std::vector<double> D0 = {-0.28, 0.074, 0.0002, 0.00002},
+                            D1 = {-0.283, 0.074, -0.0001, 0.0};
+  const SE3 T_B_C0 = cal.T_S_C;
+  const SE3 T_C0_C1(quat_from_euler_zyx({0.0, 0.0, deg2rad(1.0)}), Vec3(0.11, 0.001, -0.002));
+  const SE3 T_B_C1 = T_B_C0 * T_C0_C1;
+  auto write_yaml = [&](int i, const SE3& T, const std::vector<double>& D) {
+    const fs::path p = root / "mav0" / fmt::format("cam{}", i) / "sensor.yaml";
+    std::string y = slurp(p);
+    const auto data = y.find("  data: [");
+    y.replace(data, y.find(']', data) - data + 1,
+              "  data: [" + detail::matrix_text(detail::matrix_4x4(T), ", ") + "]");
+    const auto dist = y.find("[0.0, 0.0, 0.0, 0.0]");
+    y.replace(dist, 20, fmt::format("[{}, {}, {}, {}]", D[0], D[1], D[2], D[3]));
+    std::ofstream(p) << y;
+  };
+  write_yaml(0, T_B_C0, D0);
+  write_yaml(1, T_B_C1, D1);
+  const StereoDataset d = read_dataset(root, DatasetFormat::kEuroc);
+  ASSERT_TRUE(d.rectification);
+  EXPECT_NEAR(d.rig.baseline_m, T_C0_C1.translation().norm(), 1e-9);
+  cv::Mat lx, ly, rx, ry;
+  cv::convertMaps(d.rectification->left_map1, d.rectification->left_map2, lx, ly, CV_32FC1);
+  cv::convertMaps(d.rectification->right_map1, d.rectification->right_map2, rx, ry, CV_32FC1);
+  const cv::Matx33d K(458.7, 0, 367.2, 0, 457.3, 248.4, 0, 0, 1);
+  const SE3 T_Crect_C0 = d.T_S_C.inverse() * T_B_C0;
+  std::size_t checked = 0;
+  for (double x : {-2.0, -0.5, 0.0, 1.0, 2.5})
+    for (double y : {-1.5, 0.0, 1.2})
+      for (double z : {4.0, 9.0}) {
+        const Vec3 X_c0(x, y, z);
+        const Vec3 X_rect = T_Crect_C0 * X_c0;
+        const Eigen::Vector2d l = d.rig.camera.project(X_rect);
+        const Eigen::Vector2d r = d.rig.project_right(X_rect);
+        if (l.x() < 5 || l.x() > 745 || l.y() < 5 || l.y() > 473 || r.x() < 5 || r.x() > 745)
+          continue;
+        // The maps take a rectified pixel to the raw one; nearest map sample.
+        const auto raw_of = [](const cv::Mat& mx, const cv::Mat& my, const Eigen::Vector2d& p) {
+          const int u = static_cast<int>(std::lround(p.x())),
+                    v = static_cast<int>(std::lround(p.y()));
+          return cv::Point2d(mx.at<float>(v, u) + (p.x() - u), my.at<float>(v, u) + (p.y() - v));
+        };
+        std::vector<cv::Point2d> expected_l, expected_r;
+        cv::projectPoints(std::vector<cv::Point3d>{{x, y, z}}, cv::Vec3d(0, 0, 0),
+                          cv::Vec3d(0, 0, 0), K, D0, expected_l);
+        const Vec3 X_c1 = T_C0_C1.inverse() * X_c0;
+        cv::projectPoints(std::vector<cv::Point3d>{{X_c1.x(), X_c1.y(), X_c1.z()}},
+                          cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D1, expected_r);
+        EXPECT_LT(cv::norm(raw_of(lx, ly, l) - expected_l[0]), 0.3) << x << " " << y << " " << z;
+        EXPECT_LT(cv::norm(raw_of(rx, ry, r) - expected_r[0]), 0.3) << x << " " << y << " " << z;
+        EXPECT_NEAR(l.y(), r.y(), 1e-9);  // rectified: the same row
+        ++checked;
+      }
+  EXPECT_GE(checked, 15u);
+  const auto [left, right] = read_pair(d, d.frames[0]);
+  EXPECT_EQ(left.size(), cv::Size(752, 480));
+  EXPECT_EQ(right.type(), CV_8UC1);
+  fs::remove_all(root);
 }
 
 }  // namespace
