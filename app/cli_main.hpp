@@ -15,6 +15,8 @@ constexpr int kExitUserError = 1;    // bad input: the message names file, line,
 constexpr int kExitUsage = 2;        // bad command line
 constexpr int kExitUnavailable = 3;  // a stage this build does not have
 constexpr int kExitInternal = 4;     // a bug
+constexpr int kExitRegressed = 5;    // `regress`: a metric regressed or is missing
+constexpr int kExitJobsFailed = 6;   // `sweep run`, `run --manifest`: some jobs failed
 
 /// A subcommand whose stage this build does not have.
 struct Unavailable : std::runtime_error {

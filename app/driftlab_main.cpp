@@ -227,7 +227,7 @@ int driftlab_main(int argc, char** argv) {
   study_commands.add_run_options(run_cmd, run_scenario_opt, run_out_opt, &run_force);
   // regress: the CI baseline gate (also built alone as driftlab-gate).
   driftlab::app::GateCommand gate_command(app.add_subcommand(
-      "regress", "Compare metrics with a baseline (CI regression gate); exit 1 on a regression"));
+      "regress", "Compare metrics with a baseline (CI regression gate); exit 5 on a regression"));
 
   return driftlab::app::run_cli_main(app, argc, argv, [&]() -> int {
     if (check_cmd->parsed()) return scenario_check(check_file, check_sets, check_quiet);

@@ -1,5 +1,7 @@
 #include "app/gate_command.hpp"
 
+#include "app/cli_main.hpp"
+
 #include <fmt/format.h>
 
 #include <filesystem>
@@ -54,7 +56,7 @@ int GateCommand::run() {
         "error: {} of {} metrics regressed or are missing (compared {} with "
         "{}); if the change is intended, accept it with --update\n",
         r.failures(), r.checks.size(), file.string(), baseline_);
-    return 1;
+    return kExitRegressed;
   }
   return 0;
 }

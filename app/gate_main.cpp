@@ -8,7 +8,7 @@
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "driftlab-gate: compare metrics with a baseline (CI regression gate); exit 1 on a "
+      "driftlab-gate: compare metrics with a baseline (CI regression gate); exit 5 on a "
       "regression. The same command as `driftlab regress`."};
   app.set_version_flag("--version", std::string(DRIFTLAB_VERSION));
   driftlab::app::GateCommand gate(&app);

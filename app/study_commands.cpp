@@ -1,5 +1,7 @@
 #include "app/study_commands.hpp"
 
+#include "app/cli_main.hpp"
+
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -179,7 +181,7 @@ int StudyCommands::run_local() {
         "error: {} job(s) failed; see `driftlab sweep status {}` and "
         "{}/failed/\n",
         s.failed, quote(dir_), dir_);
-    return 1;
+    return kExitJobsFailed;
   }
   return 0;
 }
@@ -277,7 +279,7 @@ int StudyCommands::run_manifest() {
   if (!s.ok()) {
     std::cerr << fmt::format("error: {} job(s) of shard {} failed; see {}/failed/\n", s.failed,
                              shard_, m.dir.string());
-    return 1;
+    return kExitJobsFailed;
   }
   return 0;
 }

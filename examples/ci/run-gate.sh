@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The CI regression gate in one script: plans and runs a small sweep, merges it,
 # and compares the merged metrics with a committed baseline. Exit 0 when every
-# metric is within tolerance, 1 on a regression (or a missing metric), 2+ on
-# other failures. `scripts/test` runs it after ctest; the GitHub Actions
+# metric is within tolerance, 5 on a regression (or a missing metric), 6 when
+# sweep jobs failed, 1-4 on other failures (driftlab's exit codes). `scripts/test` runs it after ctest; the GitHub Actions
 # workflow beside it (github-actions.yml) does the same in CI.
 #
 # Environment (all optional):

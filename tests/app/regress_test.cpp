@@ -93,13 +93,13 @@ TEST_F(Regress, ImprovementsPassAndAreNamed) {
   EXPECT_NE(r.out.find("regress: 3 metrics: 1 pass, 2 improved"), std::string::npos) << r.out;
 }
 
-TEST_F(Regress, ARegressionExitsOneAndWritesJUnit) {
+TEST_F(Regress, ARegressionExitsFiveAndWritesJUnit) {
   write_baseline();
   write_results(0.0112, 0.44, 7.6);  // +12% > 10%; -0.06 < -0.05; +0.6 > 0.5
   const fs::path junit = dir_ / "out/junit.xml";
   fs::create_directories(junit.parent_path());
   const Result r = gate({"--junit", junit.string()});
-  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
   EXPECT_NE(r.out.find("regress: 3 metrics: 0 pass, 3 REGRESSED"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("3 of 3 metrics regressed or are missing"), std::string::npos) << r.err;
   const std::string xml = slurp(junit);
@@ -120,7 +120,7 @@ TEST_F(Regress, OnlyTheWorseDirectionRegresses) {
   write_baseline();
   write_results(0.0112, 0.9, 7.0);  // only the APE is worse
   const Result r = gate();
-  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.exit_code, 5);
   EXPECT_NE(r.out.find("regress: 3 metrics: 1 pass, 1 improved, 1 REGRESSED"), std::string::npos)
       << r.out;
 }
@@ -130,7 +130,7 @@ TEST_F(Regress, MissingAndNullMetricsFail) {
     {"key": "algorithms.pnp.ape.trans_m.rmse", "baseline": 0.01},
     {"key": "algorithms.sparse.basin.north_m.rmse", "baseline": 0.01})");
   const Result r = gate();
-  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.exit_code, 5);
   EXPECT_NE(r.out.find("MISSING: no 'pnp' under algorithms"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("MISSING: null (not computed for these results)"), std::string::npos)
       << r.out;
@@ -220,7 +220,7 @@ TEST_F(Regress, StandaloneGateBinaryMatchesRegressAndLinksNoRendererCeresOrAssim
   const Result alone = driftlab::test::run_shell(shell_quote(gate_bin.string()) + " --baseline " +
                                                  shell_quote(baseline().string()) + " --results " +
                                                  shell_quote((dir_ / "run").string()));
-  EXPECT_EQ(alone.exit_code, 1) << alone.output;
+  EXPECT_EQ(alone.exit_code, 5) << alone.output;
   EXPECT_EQ(alone.exit_code, via_driftlab.exit_code);
   EXPECT_EQ(alone.out, via_driftlab.out);
 

@@ -619,7 +619,7 @@ TEST(SweepCli, AFailingJobIsRecordedAndDoesNotStopTheOthers) {
   std::ofstream(dir / "manifest.jsonl") << manifest;
 
   r = run_cli({"sweep", "run", dir.string(), "-j", "2"});
-  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(r.exit_code, 6) << r.out << r.err;
   EXPECT_NE(r.out.find("4 jobs: ran 4, 1 failed, 0 already done; "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("failed: p0000-r01"), std::string::npos) << r.out;
   const auto rec = nlohmann::json::parse(slurp(dir / "failed/p0000-r01.json"));
