@@ -84,8 +84,9 @@ struct CaSmootherOptions {
       "Prior standard deviation of each angular acceleration component [rad/s^2]",
       yaml::positive());
     a("rts_backward_pass", rts_backward_pass,
-      "Batch smoothing only: follow the forward filter (the paper's) with a Rauch-Tung-Striebel "
-      "backward pass");
+      "Also write NAME_ca_rts estimates: the forward filter (the paper's, NAME_ca) followed by a "
+      "Rauch-Tung-Striebel backward pass over the whole run (not causal: every frame sees the "
+      "later ones)");
   }
 
   /// "" when valid, else one "field: got V, expected E" per problem, one per line.
