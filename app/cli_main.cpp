@@ -15,6 +15,9 @@ int run_cli_main(CLI::App& app, int argc, char** argv, const std::function<int()
   }
   try {
     return dispatch();
+  } catch (const UsageError& e) {
+    std::cerr << "error: " << e.what() << "\nRun with --help for more information.\n";
+    return kExitUsage;
   } catch (const Unavailable& e) {
     std::cerr << "driftlab: not available in this build yet: " << e.what() << "\n";
     return kExitUnavailable;

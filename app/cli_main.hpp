@@ -23,9 +23,15 @@ struct Unavailable : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A command line that parsed but does not make sense (e.g. a missing option that is required
+/// only without a subcommand): exit kExitUsage.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 /// Parses argv into `app` and runs `dispatch`, mapping a bad command line to kExitUsage (after
-/// CLI11 printed why; --help and --version exit 0), UserError to kExitUserError, Unavailable
-/// to kExitUnavailable and any other exception to kExitInternal.
+/// CLI11 printed why; --help and --version exit 0), UsageError to kExitUsage, UserError to
+/// kExitUserError, Unavailable to kExitUnavailable and any other exception to kExitInternal.
 int run_cli_main(CLI::App& app, int argc, char** argv, const std::function<int()>& dispatch);
 
 }  // namespace driftlab::app

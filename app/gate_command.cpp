@@ -18,12 +18,53 @@ namespace driftlab::app {
 namespace fs = std::filesystem;
 
 GateCommand::GateCommand(CLI::App* cmd) : cmd_(cmd) {
-  cmd_->add_option("--baseline", baseline_, "Baseline JSON (see docs/sweeps.md)")->required();
-  cmd_->add_option("--results", results_, "Run folder, merged sweep folder, or a metrics.json")
-      ->required();
+  cmd_->add_option("--baseline", baseline_, "Baseline JSON (see docs/sweeps.md); required");
+  cmd_->add_option("--results", results_,
+                   "Run folder, merged sweep folder, or a metrics.json; required");
   cmd_->add_option("--junit", junit_, "Also write the verdicts as JUnit XML here");
   cmd_->add_flag("--update", update_,
                  "Write the new values into the baseline (accept them) instead of failing");
+  init_ = cmd_->add_subcommand("init", "Write a new baseline from a run or a merged sweep");
+  init_->add_option("--results", init_results_, "Run folder, merged sweep folder, or metrics.json")
+      ->required();
+  init_->add_option("--baseline", init_baseline_, "The baseline file to write")->required();
+  init_
+      ->add_option("--keys", keys_,
+                   "Metrics to gate, dotted key paths (default: each algorithm's APE, track, "
+                   "section and basin errors)")
+      ->delimiter(',');
+  init_->add_option("--rel-tol", rel_tol_, "Relative tolerance of each value")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  init_->add_option("--description", description_, "What the baseline protects");
+  init_->add_flag("--force", force_, "Replace an existing baseline file");
+  cmd_->require_subcommand(0, 1);
+}
+
+int GateCommand::init() {
+  const fs::path file = gate::find_results_metrics(init_results_);
+  nlohmann::json results;
+  try {
+    results = nlohmann::json::parse(read_text_file(file, "metrics.json"));
+  } catch (const nlohmann::json::parse_error& e) {
+    throw UserError(
+        fmt::format("{}: not valid JSON ({}), expected metrics.json", file.string(), e.what()));
+  }
+  if (fs::exists(init_baseline_) && !force_)
+    throw UserError(
+        fmt::format("{}: already exists; --force replaces it, or accept new values "
+                    "into it with `regress --update`",
+                    init_baseline_));
+  gate::InitOptions o;
+  o.rel_tol = rel_tol_;
+  o.description = description_.empty() ? "baseline of " + file.string() : description_;
+  const std::vector<std::string> keys = keys_.empty() ? gate::default_gate_keys(results) : keys_;
+  gate::Baseline b = gate::baseline_from_results(results, keys, o);
+  b.file = init_baseline_;
+  write_file_atomic(init_baseline_, gate::baseline_json(b));
+  std::cout << fmt::format("regress init: {} metrics from {} into {}\n", b.metrics.size(),
+                           file.string(), init_baseline_);
+  return 0;
 }
 
 std::optional<int> GateCommand::dispatch() {
@@ -32,6 +73,14 @@ std::optional<int> GateCommand::dispatch() {
 }
 
 int GateCommand::run() {
+  if (init_->parsed()) return init();
+  if (baseline_.empty() || results_.empty())
+    throw UsageError("regress: --baseline and --results are required (or `regress init`)");
+  if (update_ && !fs::exists(baseline_))
+    throw UserError(
+        fmt::format("{}: no such baseline; create one from results with `driftlab "
+                    "regress init --results DIR --baseline {}`",
+                    baseline_, baseline_));
   const gate::Baseline baseline = gate::load_baseline(baseline_);
   const fs::path file = gate::find_results_metrics(results_);
   nlohmann::json results;

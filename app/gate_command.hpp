@@ -7,6 +7,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace driftlab::app {
 
@@ -15,15 +16,23 @@ class GateCommand {
   /// Adds the gate's options to `cmd` (the `regress` subcommand, or the whole driftlab-gate).
   explicit GateCommand(CLI::App* cmd);
 
-  /// Runs the gate if `cmd` was parsed; nullopt otherwise. Exit 0: passed; 1: regressed.
+  /// Runs the gate (or `init`) if `cmd` was parsed; nullopt otherwise. Exit 0: passed;
+  /// kExitRegressed: a metric regressed or is missing.
   std::optional<int> dispatch();
-  /// Runs the gate with the parsed options.
+  /// Runs the gate (or `init`) with the parsed options.
   int run();
 
  private:
+  int init();
+
   CLI::App* cmd_;
+  CLI::App* init_ = nullptr;
   std::string baseline_, results_, junit_;
   bool update_ = false;
+  std::string init_results_, init_baseline_, description_;
+  std::vector<std::string> keys_;
+  double rel_tol_ = 0.1;
+  bool force_ = false;
 };
 
 }  // namespace driftlab::app

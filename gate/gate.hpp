@@ -102,6 +102,26 @@ std::optional<double> metric_value(const nlohmann::json& doc, const std::string&
 GateResult check_baseline(const Baseline& baseline, const nlohmann::json& results,
                           const std::filesystem::path& results_file);
 
+/// How `regress init` sets the tolerances.
+struct InitOptions {
+  double rel_tol = 0.1;     ///< of each value
+  std::string description;  ///< written into the baseline
+};
+
+/// The metrics a baseline of these results gates when none are named: per algorithm the APE
+/// translation and rotation RMSE, the 3D track RMSE, the mean section error (when there are
+/// sections) and the basin table's north, east and heading RMSE (when present); for a merged
+/// sweep the pooled means of the APE RMSEs and of the mean section error. Only keys with a
+/// finite number.
+std::vector<std::string> default_gate_keys(const nlohmann::json& results);
+
+/// A baseline of `keys` with the values of `results`, lower is better, rel_tol of each value
+/// and, for a pooled sweep mean of n >= 2 runs, abs_tol = 2 sd / sqrt(n) (the mean's 95 %
+/// half-width: a change within it is at the level of the replicate noise). UserError naming
+/// every key the results lack, or when `keys` is empty.
+Baseline baseline_from_results(const nlohmann::json& results, const std::vector<std::string>& keys,
+                               const InitOptions& options);
+
 /// The baseline with every value replaced by the new one. Throws UserError
 /// naming the metrics the results lack (nothing is updated then).
 Baseline updated_baseline(const Baseline& baseline, const GateResult& result);

@@ -235,3 +235,58 @@ TEST_F(Regress, StandaloneGateBinaryMatchesRegressAndLinksNoRendererCeresOrAssim
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(Regress, InitWritesABaselineThatPassesTheSameResultsAndFailsDoubledErrors) {
+  Result r = run_cli(
+      {"regress", "init", "--results", (dir_ / "run").string(), "--baseline", baseline().string()});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto b = nlohmann::json::parse(slurp(baseline()));
+  ASSERT_EQ(b["metrics"].size(), 1u);  // the APE; the null basin value is not gated
+  EXPECT_EQ(b["metrics"][0]["key"], "algorithms.sparse.ape.trans_m.rmse");
+  EXPECT_EQ(b["metrics"][0]["baseline"], 0.010);
+  EXPECT_EQ(b["metrics"][0]["rel_tol"], 0.1);
+  EXPECT_EQ(gate().exit_code, 0);
+  write_results(0.020, 0.50, 7.0);  // the error doubled
+  r = gate();
+  EXPECT_EQ(r.exit_code, 5) << r.output;
+  EXPECT_NE(r.out.find("1 REGRESSED"), std::string::npos) << r.out;
+  // An existing baseline is not overwritten without --force; named keys must exist.
+  r = run_cli(
+      {"regress", "init", "--results", (dir_ / "run").string(), "--baseline", baseline().string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("already exists"), std::string::npos) << r.err;
+  r = run_cli({"regress", "init", "--results", (dir_ / "run").string(), "--baseline",
+               baseline().string(), "--force", "--keys",
+               "algorithms.sparse.regression.r2,algorithms.pnp.ape.trans_m.rmse"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("no number at: algorithms.pnp.ape.trans_m.rmse"), std::string::npos)
+      << r.err;
+}
+
+TEST_F(Regress, InitTakesTheToleranceOfASweepMeanFromItsReplicateSpread) {
+  nlohmann::json m;  // a merged sweep's summary/metrics.json, pooled over 4 runs
+  m["sweep"]["name"] = "unit";
+  m["algorithms"]["sparse"]["runs"]["ape_trans_rmse_m"] = {{"n", 4}, {"mean", 1.0}, {"sd", 0.2}};
+  std::ofstream(dir_ / "run/metrics.json") << m.dump(2);
+  const Result r = run_cli({"regress", "init", "--results", (dir_ / "run").string(), "--baseline",
+                            baseline().string(), "--rel-tol", "0"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto b = nlohmann::json::parse(slurp(baseline()));
+  ASSERT_EQ(b["metrics"].size(), 1u);
+  EXPECT_EQ(b["metrics"][0]["key"], "algorithms.sparse.runs.ape_trans_rmse_m.mean");
+  EXPECT_DOUBLE_EQ(b["metrics"][0]["abs_tol"].get<double>(), 2 * 0.2 / 2);  // 2 sd / sqrt(n)
+}
+
+TEST_F(Regress, WithoutBaselineOrResultsIsABadCommandLine) {
+  const Result r = run_cli({"regress", "--results", (dir_ / "run").string()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--baseline and --results are required"), std::string::npos) << r.err;
+  const Result u = run_cli({"regress", "--baseline", (dir_ / "none.json").string(), "--results",
+                            (dir_ / "run").string(), "--update"});
+  EXPECT_EQ(u.exit_code, 1);
+  EXPECT_NE(u.err.find("regress init"), std::string::npos) << u.err;
+}
+
+}  // namespace
