@@ -10,7 +10,6 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
-#include "core/file_io.hpp"
 #include "gate/gate.hpp"
 
 namespace driftlab::app {
@@ -43,13 +42,7 @@ GateCommand::GateCommand(CLI::App* cmd) : cmd_(cmd) {
 
 int GateCommand::init() {
   const fs::path file = gate::find_results_metrics(init_results_);
-  nlohmann::json results;
-  try {
-    results = nlohmann::json::parse(read_text_file(file, "metrics.json"));
-  } catch (const nlohmann::json::parse_error& e) {
-    throw UserError(
-        fmt::format("{}: not valid JSON ({}), expected metrics.json", file.string(), e.what()));
-  }
+  const nlohmann::json results = gate::read_results_metrics(file);
   if (fs::exists(init_baseline_) && !force_)
     throw UserError(
         fmt::format("{}: already exists; --force replaces it, or accept new values "
@@ -83,13 +76,7 @@ int GateCommand::run() {
                     baseline_, baseline_));
   const gate::Baseline baseline = gate::load_baseline(baseline_);
   const fs::path file = gate::find_results_metrics(results_);
-  nlohmann::json results;
-  try {
-    results = nlohmann::json::parse(read_text_file(file, "metrics.json"));
-  } catch (const nlohmann::json::parse_error& e) {
-    throw UserError(
-        fmt::format("{}: not valid JSON ({}), expected metrics.json", file.string(), e.what()));
-  }
+  const nlohmann::json results = gate::read_results_metrics(file);
   const gate::GateResult r = gate::check_baseline(baseline, results, file);
   std::cout << r.table();
   if (!junit_.empty()) write_file_atomic(junit_, r.junit_xml());

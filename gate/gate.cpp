@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/file_io.hpp"
 #include "core/yaml_io.hpp"
 
 namespace driftlab::gate {
@@ -216,6 +217,15 @@ fs::path find_results_metrics(const fs::path& results) {
                   "a merged sweep folder (with summary/metrics.json) or a "
                   "metrics.json file",
                   results.string()));
+}
+
+nlohmann::json read_results_metrics(const fs::path& file) {
+  try {
+    return nlohmann::json::parse(read_text_file(file, "metrics.json"));
+  } catch (const nlohmann::json::parse_error& e) {
+    throw UserError(
+        fmt::format("{}: not valid JSON ({}), expected metrics.json", file.string(), e.what()));
+  }
 }
 
 std::optional<double> metric_value(const nlohmann::json& doc, const std::string& key,

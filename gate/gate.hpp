@@ -94,6 +94,9 @@ struct GateResult {
 /// otherwise (a sweep folder not yet merged is named as such).
 std::filesystem::path find_results_metrics(const std::filesystem::path& results);
 
+/// The JSON of a metrics.json; UserError naming the file when it is not valid JSON.
+nlohmann::json read_results_metrics(const std::filesystem::path& file);
+
 /// The value at a dotted key path or JSON pointer; nullopt with `why` when
 /// absent, null or not a number.
 std::optional<double> metric_value(const nlohmann::json& doc, const std::string& key,

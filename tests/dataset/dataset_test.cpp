@@ -212,14 +212,7 @@ TEST(TumRgbdExport, DepthIsSixteenBitAtFiveThousandPerMetre) {
   fs::remove_all(root);
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const UserError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+const auto error_of = driftlab::test::user_error_of;
 
 TEST(DatasetReaders, NameTheFileLineAndExpectation) {
   const fs::path root = test::fresh_temp_dir("dataset_errors");

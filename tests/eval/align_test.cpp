@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/test_support.hpp"
+
 #include "core/error.hpp"
 #include "core/rotation.hpp"
 
@@ -48,14 +50,7 @@ void expect_transform(const SimilarityTransform& T, double s, const Mat3& R, con
   EXPECT_NEAR(T.R.determinant(), 1.0, tol);
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const UserError& e) {
-    return e.what();
-  }
-  return "(no UserError)";
-}
+const auto error_of = driftlab::test::user_error_of;
 
 void expect_error(const std::function<void()>& f, const std::string& part) {
   const std::string msg = error_of(f);

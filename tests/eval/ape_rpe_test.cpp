@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/test_support.hpp"
+
 #include "core/error.hpp"
 #include "core/rotation.hpp"
 #include "eval/align.hpp"
@@ -60,14 +62,7 @@ std::vector<Vec3> translations(const std::vector<SE3>& poses) {
   return p;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const UserError& e) {
-    return e.what();
-  }
-  return "(no UserError)";
-}
+const auto error_of = driftlab::test::user_error_of;
 
 void expect_error(const std::function<void()>& f, const std::string& part) {
   const std::string msg = error_of(f);

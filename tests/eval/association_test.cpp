@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/test_support.hpp"
+
 #include "core/error.hpp"
 
 namespace driftlab::eval {
@@ -20,14 +22,7 @@ Trajectory at_stamps(const std::vector<TimeNs>& stamps) {
   return t;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const UserError& e) {
-    return e.what();
-  }
-  return "(no UserError)";
-}
+const auto error_of = driftlab::test::user_error_of;
 
 using Ids = std::vector<std::size_t>;
 

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/test_support.hpp"
+
 #include "core/error.hpp"
 #include "core/rotation.hpp"
 
@@ -109,14 +111,7 @@ TEST(KittiSegmentsTest, LengthsWithoutASegmentAreLeftOut) {
   EXPECT_TRUE(kitti_errors({}, {}).per_length.empty());
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const UserError& e) {
-    return e.what();
-  }
-  return "(no UserError)";
-}
+const auto error_of = driftlab::test::user_error_of;
 
 TEST(KittiSegmentsTest, BadOptionsAreUserErrors) {
   const std::vector<SE3> gt = straight_1000m();

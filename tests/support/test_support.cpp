@@ -1,5 +1,7 @@
 #include "tests/support/test_support.hpp"
 
+#include "core/error.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -42,6 +44,15 @@ fs::path fresh_temp_dir(const std::string& name) {
   const fs::path p = unused_temp_path(name);
   fs::create_directories(p);
   return p;
+}
+
+std::string user_error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const UserError& e) {
+    return e.what();
+  }
+  return "(no UserError)";
 }
 
 std::string shell_quote(const std::string& text) {

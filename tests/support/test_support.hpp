@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,9 @@ std::string slurp(const std::filesystem::path& path);
 
 /// The "# expect: TEXT" comment lines of a bad input file: what its error message must contain.
 std::vector<std::string> expected_messages(const std::filesystem::path& file);
+
+/// What the UserError thrown by `f` says, or "(no UserError)" when it throws none.
+std::string user_error_of(const std::function<void()>& f);
 
 /// A path under the temporary folder, unique to this process and `name`, that does not exist.
 std::filesystem::path unused_temp_path(const std::string& name);

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/test_support.hpp"
+
 #include "core/error.hpp"
 
 namespace driftlab::vo {
@@ -24,14 +26,7 @@ class FixedVo final : public StereoOdometry {
   double x_;
 };
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const UserError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+const auto error_of = driftlab::test::user_error_of;
 
 TEST(VoRegistry, RegistersByNameAndRefusesTakenOrUnsafeNames) {
   const VoFactory factory = [](const StereoRig& rig, Rng) {
