@@ -36,6 +36,12 @@ const std::vector<RunMetric>& run_metrics() {
       {"ape_rot_rmse_deg", "ape.rot_deg.rmse", "APE rotation RMSE [deg]"},
       {"rpe_trans_rmse_m", "rpe.trans_m.rmse", "RPE translation RMSE [m]"},
       {"rpe_rot_rmse_deg", "rpe.rot_deg.rmse", "RPE rotation RMSE [deg]"},
+      {"track_rmse_3d_m", "track.rmse_3d_m", "track RMSE 3D [m]"},
+      {"track_length_error_pct", "track.length_error_pct", "track length error [%]"},
+      // The basin paper's table (Section 4): what the wave sweeps are for.
+      {"basin_north_rmse_m", "basin.north_m.rmse", "basin table: north RMSE [m]"},
+      {"basin_east_rmse_m", "basin.east_m.rmse", "basin table: east RMSE [m]"},
+      {"basin_heading_rmse_deg", "basin.heading_deg.rmse", "basin table: heading RMSE [deg]"},
   };
   return metrics;
 }
@@ -149,6 +155,16 @@ struct RunData {
 };
 
 }  // namespace
+
+double run_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
+                        const RunMetric& metric) {
+  const std::string at = "algorithms." + algorithm + ".";
+  // A run without sections has no section statistics (its zeros are not errors of 0).
+  if (std::string_view(metric.path).starts_with("sections.") &&
+      !(json_number(metrics, at + "sections.count") > 0))
+    return std::numeric_limits<double>::quiet_NaN();
+  return json_number(metrics, at + metric.path);
+}
 
 std::string MergeSummary::brief() const {
   std::string algos;
@@ -476,8 +492,7 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
     ja["runs"] = nlohmann::ordered_json::object();
     for (const auto& rm : run_metrics()) {
       std::vector<double> v;
-      for (const auto& r : runs)
-        v.push_back(json_number(r.metrics, "algorithms." + algo + "." + rm.path));
+      for (const auto& r : runs) v.push_back(run_metric_value(r.metrics, algo, rm));
       ja["runs"][rm.name] = stat_json(stat_of(v));
     }
     metrics["algorithms"][algo] = ja;
@@ -498,7 +513,7 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
       for (const auto& [name, value] : r.job->params) row.push_back(value);
       row.push_back(algo);
       for (const auto& rm : run_metrics())
-        row.push_back(num(json_number(r.metrics, "algorithms." + algo + "." + rm.path)));
+        row.push_back(num(run_metric_value(r.metrics, algo, rm)));
       runs_csv += csv_row(row);
     }
 
@@ -538,8 +553,7 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
       row.push_back(std::to_string(point_runs.size()));
       for (const auto& rm : run_metrics()) {
         std::vector<double> v;
-        for (const RunData* r : point_runs)
-          v.push_back(json_number(r->metrics, "algorithms." + algo + "." + rm.path));
+        for (const RunData* r : point_runs) v.push_back(run_metric_value(r->metrics, algo, rm));
         const Stat s = stat_of(v);
         row.push_back(num(s.mean));
         row.push_back(num(s.sd));
@@ -620,7 +634,7 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
             for (const auto& r : runs)
               for (const auto& [name, value] : r.job->params)
                 if (name == a.name && value == values[k])
-                  v.push_back(json_number(r.metrics, "algorithms." + algo + "." + rm.path));
+                  v.push_back(run_metric_value(r.metrics, algo, rm));
             const Stat s = stat_of(v);
             if (s.n == 0) continue;
             std::string label = values[k];

@@ -62,6 +62,10 @@ struct RunMetric {
   const char* label;  // axis label of plots
 };
 const std::vector<RunMetric>& run_metrics();
+/// A run metric of one algorithm in a run's metrics.json; NaN (missing) when absent, and for
+/// the section statistics of a run that has no section.
+double run_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
+                        const RunMetric& metric);
 
 /// Two-sided 95% confidence interval of a mean from n samples with sample
 /// standard deviation sd (Student's t with n - 1 degrees of freedom);

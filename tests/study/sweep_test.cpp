@@ -434,6 +434,25 @@ TEST(SweepFiles, ShippedSweepsAndTheCiBaselineAreValid) {
   for (const auto& m : b.metrics) EXPECT_TRUE(m.baseline.has_value()) << m.key;
 }
 
+TEST(SweepMerge, RunMetricsIncludeTheBasinTableAndMissingSectionsAreMissing) {
+  const auto metric = [](const std::string& name) {
+    for (const auto& rm : run_metrics())
+      if (rm.name == name) return rm;
+    ADD_FAILURE() << name << " is not a run metric";
+    return run_metrics().front();
+  };
+  nlohmann::json run;  // a 2.5 m basin tow: no 6.5 m section, a basin table
+  run["algorithms"]["pnp"]["sections"] = {{"count", 0}, {"p_m_per_m", {{"mean", 0.0}}}};
+  run["algorithms"]["pnp"]["basin"]["north_m"]["rmse"] = 0.062;
+  run["algorithms"]["pnp"]["ape"]["trans_m"]["rmse"] = 0.01;
+  EXPECT_TRUE(std::isnan(run_metric_value(run, "pnp", metric("p_m_per_m_mean"))));
+  EXPECT_EQ(run_metric_value(run, "pnp", metric("basin_north_rmse_m")), 0.062);
+  EXPECT_EQ(run_metric_value(run, "pnp", metric("ape_trans_rmse_m")), 0.01);
+  EXPECT_TRUE(std::isnan(run_metric_value(run, "pnp", metric("basin_east_rmse_m"))));
+  run["algorithms"]["pnp"]["sections"]["count"] = 3;
+  EXPECT_EQ(run_metric_value(run, "pnp", metric("p_m_per_m_mean")), 0.0);
+}
+
 TEST(SweepMerge, ConfidenceIntervalUsesStudentsT) {
   // t quantiles 0.975 with 1 and 4 degrees of freedom: 12.706204736174698, 2.7764451051977934.
   auto [lo2, hi2] = confidence_interval_95(10.0, 1.0, 2);
