@@ -528,7 +528,12 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
   std::map<std::size_t, std::vector<const RunData*>> by_point;  // ordered by point index
   for (const auto& r : runs) by_point[r.job->point].push_back(&r);
   metrics["points"] = nlohmann::ordered_json::object();
-  const std::string& main_metric = run_metrics().front().name;
+  // The table shows the first run metric the runs have (sections, else the APE, else ...).
+  std::string main_metric = run_metrics().front().name;
+  for (auto it = run_metrics().rbegin(); it != run_metrics().rend(); ++it)
+    for (const auto& r : runs)
+      for (const auto& algo : out.algorithms)
+        if (std::isfinite(run_metric_value(r.metrics, algo, *it))) main_metric = it->name;
   md +=
       fmt::format("\n## Points\n\n`{}` per point, mean over replicates [95% CI]:\n\n", main_metric);
   md += "| point |";
