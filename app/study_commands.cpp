@@ -91,6 +91,9 @@ StudyCommands::StudyCommands(CLI::App& app) {
   merge_->add_flag("--allow-missing", allow_missing_,
                    "Merge the finished jobs even when some are not done");
   merge_->add_flag("--no-plots", no_plots_, "Do not run gnuplot");
+  merge_->add_option("--regress", run_regressions_,
+                     "Run-level regression METRIC~AXIS[+AXIS...] (repeatable), e.g. "
+                     "basin_north_rmse_m~amplitude_m+wavelength_m");
 
   slurm_ = sweep_->add_subcommand(
       "slurm-script", "Write DIR/slurm/sweep.sbatch: a Slurm job array over shards of the jobs");
@@ -234,6 +237,7 @@ int StudyCommands::merge() {
   pl::MergeOptions o;
   o.covariates = covariates_;
   o.response = response_;
+  o.run_regressions = run_regressions_;
   o.allow_missing = allow_missing_;
   o.plots = !no_plots_;
   const pl::MergeSummary s = pl::merge_sweep(m, o);

@@ -46,7 +46,7 @@ class StudyCommands {
   std::string sweep_file_, dir_, out_;
   bool force_ = false;
   std::size_t parallel_ = 1;
-  std::vector<std::string> covariates_;
+  std::vector<std::string> covariates_, run_regressions_;
   std::string response_ = "p_m_per_m";
   bool allow_missing_ = false, no_plots_ = false;
   std::string partition_, time_, driftlab_;

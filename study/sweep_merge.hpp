@@ -31,6 +31,10 @@ struct MergeOptions {
   std::vector<std::string> covariates;
   /// The regression's response: a column of the pooled table.
   std::string response = "p_m_per_m";
+  /// Run-level regressions, "METRIC~AXIS[+AXIS...]": a run metric (a runs.csv column such
+  /// as basin_north_rmse_m, or a key path under algorithms.ALGO of a run's metrics.json) on
+  /// swept axes, by OLS over the runs of each algorithm (metrics.json run_regressions).
+  std::vector<std::string> run_regressions;
   /// Merge the finished jobs even when some are not done.
   bool allow_missing = false;
   /// Make PNG plots with gnuplot (skipped, with a warning, when not installed).
@@ -51,7 +55,8 @@ struct MergeSummary {
 
 /// Merges the sweep folder into DIR/summary (written aside, renamed into
 /// place). Throws UserError, writing nothing, when jobs are not done (unless
-/// allow_missing) or a requested covariate or response is not a column.
+/// allow_missing), a requested covariate or response is not a column, or a --regress names
+/// no numeric axis.
 MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& options = {});
 
 /// The run metrics that points.csv and runs.csv summarise: name and the key

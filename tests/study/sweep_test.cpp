@@ -20,6 +20,7 @@
 #include <sstream>
 #include <thread>
 
+#include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/process.hpp"
 #include "core/rng.hpp"
@@ -686,6 +687,57 @@ TEST(SweepCli, OneLocalRunnerAtATime) {
       << r.err;
   EXPECT_FALSE(fs::exists(dir / "runs"));
   ::close(fd);
+  fs::remove_all(dir);
+}
+
+TEST(SweepCli, MergeRegressesAnyRunMetricOnTheAxes) {
+  const fs::path dir = temp_dir("run_regress");
+  Result r =
+      run_cli({"sweep", "plan", (kSweeps / "tiny_grid.yaml").string(), "--out", dir.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = run_cli({"sweep", "run", dir.string(), "-j", "2"});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = run_cli({"sweep", "merge", dir.string(), "--no-plots", "--regress", "ape_trans_rmse_m"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("expected METRIC~AXIS[+AXIS...]"), std::string::npos) << r.err;
+  r = run_cli({"sweep", "merge", dir.string(), "--no-plots", "--regress", "ape_trans_rmse_m~wind"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("got axis 'wind', expected a numeric axis of the sweep: yaw_amp_deg"),
+            std::string::npos)
+      << r.err;
+  r = run_cli(
+      {"sweep", "merge", dir.string(), "--no-plots", "--regress", "ape_trans_rmse_m~yaw_amp_deg"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The slope by hand from runs.csv: cov(x, y) / var(x) over the 4 runs.
+  std::istringstream csv(slurp(dir / "summary/runs.csv"));
+  std::string line;
+  std::getline(csv, line);
+  const auto header = split_csv_line(line);
+  const auto col = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  std::vector<double> x, y;
+  while (std::getline(csv, line)) {
+    const auto cells = split_csv_line(line);
+    if (cells[col("algorithm")] != "sparse") continue;
+    x.push_back(std::stod(cells[col("yaw_amp_deg")]));
+    y.push_back(std::stod(cells[col("ape_trans_rmse_m")]));
+  }
+  ASSERT_EQ(x.size(), 4u);
+  const double mx = (x[0] + x[1] + x[2] + x[3]) / 4, my = (y[0] + y[1] + y[2] + y[3]) / 4;
+  double sxy = 0, sxx = 0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    sxy += (x[i] - mx) * (y[i] - my);
+    sxx += (x[i] - mx) * (x[i] - mx);
+  }
+  const auto m = nlohmann::json::parse(slurp(dir / "summary/metrics.json"));
+  const auto& fit = m["algorithms"]["sparse"]["run_regressions"]["ape_trans_rmse_m~yaw_amp_deg"];
+  EXPECT_EQ(fit["n"], 4);
+  EXPECT_NEAR(fit["coefficients"]["yaw_amp_deg"]["estimate"].get<double>(), sxy / sxx,
+              1e-12 * std::max(1.0, std::abs(sxy / sxx)));
+  EXPECT_NE(slurp(dir / "summary/summary.md")
+                .find("Regression of `ape_trans_rmse_m` on `yaw_amp_deg` over the runs"),
+            std::string::npos);
   fs::remove_all(dir);
 }
 
