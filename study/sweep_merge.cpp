@@ -726,7 +726,7 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
                          });
       bool log_x = a.spec == "logspace";
       for (const auto& v : values) log_x = log_x && a.numeric && cell_number(v) > 0;
-      for (std::size_t mi = 0; mi < 3 && mi < run_metrics().size(); ++mi) {
+      for (std::size_t mi = 0; mi < run_metrics().size(); ++mi) {  // those the runs have
         const RunMetric& rm = run_metrics()[mi];
         const std::string stem = file_safe(a.name) + "__" + rm.name;
         std::string dat = fmt::format(
