@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/markup.hpp"
 #include "core/yaml_io.hpp"
 
 namespace driftlab::gate {
@@ -24,36 +25,6 @@ std::string where_of(const std::string& label, const YAML::Node& node) {
 }
 
 std::string g(double v) { return fmt::format("{:.6g}", v); }
-
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:
-        // XML 1.0 forbids most control characters, even escaped.
-        if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t' && c != '\r')
-          out += '?';
-        else
-          out += c;
-    }
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -390,16 +361,16 @@ std::string GateResult::junit_xml() const {
   x += fmt::format(
       "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"0\" "
       "skipped=\"0\">\n",
-      xml_escape(suite), checks.size(), failures());
+      markup_escape(suite), checks.size(), failures());
   x += "    <properties>\n";
   x += fmt::format("      <property name=\"baseline\" value=\"{}\"/>\n",
-                   xml_escape(baseline_file.string()));
+                   markup_escape(baseline_file.string()));
   x += fmt::format("      <property name=\"results\" value=\"{}\"/>\n",
-                   xml_escape(results_file.string()));
+                   markup_escape(results_file.string()));
   x += "    </properties>\n";
   for (const auto& c : checks) {
-    x += fmt::format("    <testcase classname=\"{}\" name=\"{}\" time=\"0\"", xml_escape(suite),
-                     xml_escape(c.metric.key));
+    x += fmt::format("    <testcase classname=\"{}\" name=\"{}\" time=\"0\"", markup_escape(suite),
+                     markup_escape(c.metric.key));
     if (!c.failed()) {
       x += "/>\n";
       continue;
@@ -417,10 +388,10 @@ std::string GateResult::junit_xml() const {
           yaml::enum_name(c.metric.direction));
     }
     x += fmt::format(">\n      <failure type=\"{}\" message=\"{}\">{}</failure>\n    </testcase>\n",
-                     xml_escape(std::string(yaml::enum_name(c.verdict))), xml_escape(message),
-                     xml_escape(message));
+                     markup_escape(std::string(yaml::enum_name(c.verdict))), markup_escape(message),
+                     markup_escape(message));
   }
-  x += "    <system-out>" + xml_escape(table()) + "</system-out>\n";
+  x += "    <system-out>" + markup_escape(table()) + "</system-out>\n";
   x += "  </testsuite>\n</testsuites>\n";
   return x;
 }

@@ -10,6 +10,7 @@
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "core/markup.hpp"
 #include "core/rotation.hpp"
 #include "core/time.hpp"
 #include "core/yaml_io.hpp"
@@ -56,29 +57,6 @@ std::vector<std::string> split_pipes(const std::string& text) {
   std::istringstream in(text);
   while (std::getline(in, cell, '|')) out.push_back(cell);
   if (!text.empty() && text.back() == '|') out.emplace_back();
-  return out;
-}
-
-std::string html_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
   return out;
 }
 
@@ -228,6 +206,11 @@ PlotSet make_plots(const std::filesystem::path& dir, const Trajectory& gt,
   const GnuplotRun run = run_gnuplot(*lookup.gnuplot, plots, "plots.gp", "gnuplot.log");
   if (!run.ok) return {{}, fmt::format("gnuplot failed ({}): see plots/gnuplot.log", run.failure)};
   return {made, ""};
+}
+
+// HTML text and double-quoted attributes: apostrophes stay as they are ("e'_p").
+static std::string html_escape(std::string_view s) {
+  return markup_escape(s, MarkupQuotes::kDoubleOnly);
 }
 
 std::string report_html(const std::string& title, const std::string& markdown,
