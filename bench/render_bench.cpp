@@ -28,8 +28,7 @@ void render_bench(benchmark::State& state, const char* scenario_file, bool basin
   const sim::SceneGeometry scene = scenes::build_scene(sc.scene, sc.seed, -10, 60);
   sim::StereoRenderer renderer(pipeline::rig_of(sc.sensors.camera), sc.render);
   renderer.upload(scene);
-  renderer.set_waves(
-      sim::wave_components(sc.water.waves, RngStreams(sc.seed).stream("waves.phases")));
+  pipeline::set_water_surface(&renderer, sc);
   // A camera 0.5 m above the water looking along the river, slowly moving.
   double t = 0;
   for (auto _ : state) {

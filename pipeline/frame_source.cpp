@@ -38,7 +38,7 @@ struct Renderer {
   Renderer(const Scenario& sc, const sim::SceneGeometry& scene)
       : rng(sc.seed), renderer(rig_of(sc.sensors.camera), sc.render) {
     renderer.upload(scene);
-    renderer.set_waves(sim::wave_components(sc.water.waves, rng.stream("waves.phases")));
+    set_water_surface(&renderer, sc);
     camera.emplace(sc, &renderer, rng);
   }
   CapturedFrame capture(std::size_t k, const FrameTruth& truth, bool depth) {

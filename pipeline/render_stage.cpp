@@ -41,6 +41,12 @@ std::string RenderSequenceSummary::brief() const {
       frames, triangles, pairs_per_s, scene_build_s, context);
 }
 
+void set_water_surface(sim::StereoRenderer* renderer, const Scenario& sc) {
+  const RngStreams rng(sc.seed);
+  renderer->set_waves(sim::wave_components(sc.water.waves, rng.stream("waves.phases")));
+  renderer->set_ripples(sim::wind_ripples(sc.water.wind, rng.stream("water.ripples")));
+}
+
 StereoRig rig_of(const sim::CameraOptions& c) {
   StereoRig rig;
   rig.camera.fx = c.fx_px;
@@ -86,8 +92,7 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
   summary.scene_build_s = seconds_since(t_scene);
   sim::StereoRenderer renderer(rig_of(sc.sensors.camera), sc.render);
   renderer.upload(scene);
-  renderer.set_waves(
-      sim::wave_components(sc.water.waves, RngStreams(sc.seed).stream("waves.phases")));
+  set_water_surface(&renderer, sc);
   summary.triangles = renderer.triangles();
   summary.context = renderer.context_description();
 

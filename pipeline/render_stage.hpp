@@ -8,6 +8,10 @@
 #include "core/camera.hpp"
 #include "pipeline/scenario.hpp"
 
+namespace driftlab::sim {
+class StereoRenderer;
+}
+
 namespace driftlab::pipeline {
 
 struct RenderSequenceOptions {
@@ -28,6 +32,10 @@ struct RenderSequenceSummary {
 
 /// The stereo rig of the scenario's camera options.
 StereoRig rig_of(const sim::CameraOptions& camera);
+
+/// Shows the scenario's water on `renderer`: the wave field (with the phases
+/// the vessel physics uses) and the wind ripples.
+void set_water_surface(sim::StereoRenderer* renderer, const Scenario& scenario);
 
 /// Simulates the motion, builds the scene around the track, renders every
 /// frame into out_dir/{left,right}/NNNNNN.png (+ depth/NNNNNN.pfm) and

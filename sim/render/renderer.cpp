@@ -164,8 +164,10 @@ out float v_view_z;
 #else
 out vec4 v_shade;          // normal x, y (reflection offset); Fresnel; fog
 #endif
-#if SUN && !DEPTH
+#if (SUN || RIPPLES) && !DEPTH
 out vec3 v_world;
+#endif
+#if SUN && !DEPTH
 out vec3 v_normal;
 #endif
 void main() {
@@ -189,8 +191,10 @@ void main() {
   float m = 1.0 - cos_t, m2 = m * m;
   float fresnel = (0.02 + 0.98 * m2 * m2 * m) * u_reflectivity * (1.0 - 0.5 * u_turbidity);
   v_shade = vec4(n.xy, fresnel, exp(-length(u_eye - p) / u_fog));
-#if SUN
+#if SUN || RIPPLES
   v_world = p;
+#endif
+#if SUN
   v_normal = n;
 #endif
 #endif
@@ -204,10 +208,20 @@ in float v_view_z;
 #else
 in vec4 v_shade;
 #endif
-#if SUN && !DEPTH
+#if (SUN || RIPPLES) && !DEPTH
 in vec3 v_world;
+#endif
+#if SUN && !DEPTH
 in vec3 v_normal;
 #endif
+const int R = 16;
+uniform vec4 u_ripple[R];       // kx, ky, omega, slope amplitude a k
+uniform float u_ripple_phase[R];
+uniform int u_ripple_count;
+uniform float u_time;
+uniform mat4 u_view;
+uniform vec2 u_focal;           // fx, fy [px]
+uniform float u_refl_max_lod;
 uniform vec3 u_eye;
 uniform sampler2D u_reflection;
 uniform bool u_has_reflection;
@@ -217,6 +231,15 @@ uniform float u_turbidity;
 uniform float u_sky;
 uniform vec3 u_sun_dir;
 out vec4 frag;
+#if RIPPLES && !DEPTH
+// Pixel position of the reflection in the mirror image of the ray from the
+// eye to this fragment, reflected off a surface of slope s (grad eta).
+vec2 mirror_px(vec2 s) {
+  vec3 d = normalize(v_world - u_eye);
+  vec3 r = mat3(u_view) * reflect(d, normalize(vec3(-s, -1.0)));
+  return u_focal * r.xy / max(r.z, 0.05);
+}
+#endif
 void main() {
 #if DEPTH
   frag = vec4(v_view_z, 0.0, 0.0, 1.0);
@@ -224,7 +247,54 @@ void main() {
   float refl = u_sky;
   if (u_has_reflection) {
     vec2 uv = gl_FragCoord.xy / u_viewport + 0.15 * v_shade.xy * vec2(1.0, -1.0);
+#if RIPPLES
+    // Wind ripples: those at least 4 pixels long are drawn, fading out
+    // below (so they never alias); the slope variance of the shorter ones
+    // blurs the reflection instead, as a rough mirror does.
+    vec2 xy = v_world.xy;
+    float foot = max(length(dFdx(xy)), length(dFdy(xy)));  // water surface per pixel [m]
+    vec2 slope = vec2(0.0);
+    float unresolved = 0.0;
+    for (int i = 0; i < u_ripple_count; ++i) {
+      vec2 k = u_ripple[i].xy;
+      float keep = smoothstep(2.0, 4.0, 6.2831853 / (length(k) * foot));
+      float th = dot(k, xy) - u_ripple[i].z * u_time + u_ripple_phase[i];
+      slope -= keep * u_ripple[i].w * sin(th) * normalize(k);
+      unresolved += (1.0 - keep * keep) * 0.5 * u_ripple[i].w * u_ripple[i].w;
+    }
+    // Where the reflected ray through the rippled surface lands in the
+    // mirror image, against the ray through the flat surface: exact for
+    // the reflection of distant objects.
+    vec2 p0 = mirror_px(vec2(0.0)), p1 = mirror_px(slope);
+    uv += (p1 - p0) / u_viewport;
+    // The unresolved ripples spread the reflected rays: the spread of their
+    // image is J S J^T, J the Jacobian of mirror_px in the slope and S the
+    // slope covariance (isotropic). At grazing angles it is long and
+    // vertical (the streaks of a rippled reflection): the long axis is
+    // sampled in five taps, the short one by the mip level.
+    const float eps = 0.01;
+    mat2 J = mat2((mirror_px(slope + vec2(eps, 0.0)) - p1) / eps,
+                  (mirror_px(slope + vec2(0.0, eps)) - p1) / eps);
+    mat2 C = 0.5 * unresolved * J * transpose(J);
+    float half_tr = 0.5 * (C[0][0] + C[1][1]);
+    float det = C[0][0] * C[1][1] - C[0][1] * C[1][0];
+    float root = sqrt(max(half_tr * half_tr - det, 0.0));
+    float major = sqrt(half_tr + root), minor = sqrt(max(half_tr - root, 0.0));
+    vec2 axis = abs(C[1][0]) > 1e-9 ? normalize(vec2(half_tr + root - C[1][1], C[1][0]))
+                                    : (C[0][0] >= C[1][1] ? vec2(1.0, 0.0) : vec2(0.0, 1.0));
+    // A mip level of width w texels (2 w pixels) has a standard deviation
+    // of about w / 2.5 texels.
+    float lod = clamp(log2(max(1.25 * minor, 1.0)), 0.0, u_refl_max_lod);
+    vec2 step = axis * (major / 0.866) / u_viewport;  // taps -2..2 at 0.75 step: sd 0.866
+    const float w[5] = float[5](1.0, 2.0, 3.0, 2.0, 1.0);
+    float sum = 0.0;
+    for (int j = 0; j < 5; ++j)
+      sum += w[j] * textureLod(u_reflection, clamp(uv + (0.75 * float(j - 2)) * step,
+                                                   vec2(0.0), vec2(1.0)), lod).r;
+    refl = sum / 9.0;
+#else
     refl = texture(u_reflection, clamp(uv, vec2(0.0), vec2(1.0))).r;
+#endif
   }
   float body = u_body * (0.6 + 0.8 * u_turbidity);
   float g = mix(body, refl, v_shade.z);
@@ -328,8 +398,9 @@ struct StereoRenderer::Impl {
   RenderOptions options;
   std::unique_ptr<GlContext> context;
   // Programs by variant: [mode][sun] with mode 0 gray, 1 linear depth.
-  GLuint scene_progs[2][2] = {}, water_progs[2][2] = {};
-  GLuint sky_progs[2] = {};  // [sun]
+  GLuint scene_progs[2][2] = {};
+  GLuint water_progs[2][2][2] = {};  // [mode][sun][ripples]
+  GLuint sky_progs[2] = {};          // [sun]
   GLuint empty_vao = 0;
   std::vector<GpuMesh> meshes;
   std::vector<GLuint> textures;
@@ -342,6 +413,9 @@ struct StereoRenderer::Impl {
   float wave_amplitude_sum_m = 0;
   std::vector<float> wave_a;  // 4 per component
   std::vector<float> wave_phase;
+  std::vector<float> ripple_a;  // 4 per ripple: kx, ky, omega, slope amplitude
+  std::vector<float> ripple_phase;
+  int refl_levels = 1;
   // Framebuffers.
   // Framebuffers, one set per eye: both eyes are drawn before either is read
   // back, so llvmpipe rasterises the left eye while the right eye's vertices
@@ -359,7 +433,8 @@ struct StereoRenderer::Impl {
   void build_water_grid();
   void build_framebuffers();
   void build_eye_targets(EyeTargets* e);
-  void color_target_(GLuint* fbo, GLuint* tex, unsigned format, GLuint* depth_rb, int W, int H);
+  void color_target_(GLuint* fbo, GLuint* tex, unsigned format, GLuint* depth_rb, int W, int H,
+                     int levels = 1);
   void draw_scene(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, float mirror, int mode);
   void draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, double t, int mode,
                   GLuint reflection);  // 0: none
@@ -382,7 +457,9 @@ StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& option
     for (int sun : {0, 1}) {
       const std::string defines = fmt::format("#define DEPTH {}\n#define SUN {}\n", mode, sun);
       impl_->scene_progs[mode][sun] = program(kSceneVs, kSceneFs, "scene", defines);
-      impl_->water_progs[mode][sun] = program(kWaterVs, kWaterFs, "water", defines);
+      for (int ripples : {0, 1})
+        impl_->water_progs[mode][sun][ripples] = program(
+            kWaterVs, kWaterFs, "water", defines + fmt::format("#define RIPPLES {}\n", ripples));
     }
   for (int sun : {0, 1})
     impl_->sky_progs[sun] = program(kSkyVs, kSkyFs, "sky", fmt::format("#define SUN {}\n", sun));
@@ -451,12 +528,12 @@ void StereoRenderer::Impl::build_water_grid() {
 }
 
 void StereoRenderer::Impl::color_target_(GLuint* fbo, GLuint* tex, unsigned format,
-                                         GLuint* depth_rb, int W, int H) {
+                                         GLuint* depth_rb, int W, int H, int levels) {
   glGenFramebuffers(1, fbo);
   glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
   glGenTextures(1, tex);
   glBindTexture(GL_TEXTURE_2D, *tex);
-  glTexStorage2D(GL_TEXTURE_2D, 1, format, W, H);
+  glTexStorage2D(GL_TEXTURE_2D, levels, format, W, H);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -499,8 +576,11 @@ void StereoRenderer::Impl::build_eye_targets(EyeTargets* e) {
 
   color_target_(&e->resolve_fbo, &e->resolve_tex, GL_R8, nullptr, W, H);
   // The reflection is blurred by the waves and the Fresnel mix anyway: half
-  // resolution costs a quarter of the fill for no visible loss.
-  color_target_(&e->refl_fbo, &e->refl_tex, GL_R8, &e->refl_depth, (W + 1) / 2, (H + 1) / 2);
+  // resolution costs a quarter of the fill for no visible loss. Its mip
+  // levels (made only when wind ripples blur it) are the rough-mirror blur.
+  const int RW = (W + 1) / 2, RH = (H + 1) / 2;
+  refl_levels = 1 + static_cast<int>(std::floor(std::log2(std::max(RW, RH))));
+  color_target_(&e->refl_fbo, &e->refl_tex, GL_R8, &e->refl_depth, RW, RH, refl_levels);
 }
 
 void StereoRenderer::upload(const SceneGeometry& scene) {
@@ -602,6 +682,30 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
   m.scene.water = scene.water;
 }
 
+void StereoRenderer::set_ripples(const std::vector<WaveComponent>& components) {
+  Impl& m = *impl_;
+  std::vector<WaveComponent> c = components;
+  if (c.size() > static_cast<std::size_t>(kMaxShaderRipples)) c.resize(kMaxShaderRipples);
+  m.ripple_a.clear();
+  m.ripple_phase.clear();
+  for (const auto& w : c) {
+    m.ripple_a.insert(m.ripple_a.end(),
+                      {static_cast<float>(w.wavenumber_rad_m * std::cos(w.direction_rad)),
+                       static_cast<float>(w.wavenumber_rad_m * std::sin(w.direction_rad)),
+                       static_cast<float>(w.omega_rad_s),
+                       static_cast<float>(w.amplitude_m * w.wavenumber_rad_m)});
+    m.ripple_phase.push_back(static_cast<float>(w.phase_rad));
+  }
+  // The mirror image is sampled from its mip levels only when ripples blur it.
+  m.context->make_current();
+  for (const auto& e : m.eyes) {
+    glBindTexture(GL_TEXTURE_2D, e.refl_tex);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
+                    c.empty() ? GL_LINEAR : GL_LINEAR_MIPMAP_LINEAR);
+  }
+  glBindTexture(GL_TEXTURE_2D, 0);
+}
+
 void StereoRenderer::set_waves(const std::vector<WaveComponent>& components) {
   std::vector<WaveComponent> c = components;
   std::stable_sort(c.begin(), c.end(), [](const WaveComponent& a, const WaveComponent& b) {
@@ -672,7 +776,7 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   if (!scene.water.enabled) return;
   const Lighting& L = scene.lighting;
   const WaterAppearance& w = scene.water;
-  const GLuint water_prog = water_progs[mode][L.sun ? 1 : 0];
+  const GLuint water_prog = water_progs[mode][L.sun ? 1 : 0][ripple_phase.empty() ? 0 : 1];
   glUseProgram(water_prog);
   set_mat4(water_prog, "u_view", view);
   set_mat4(water_prog, "u_proj", proj);
@@ -696,6 +800,15 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   glUniform1f(loc(water_prog, "u_fog"), L.fog_distance_m);
   const Eigen::Vector3f sun = L.sun_direction_W.normalized();
   glUniform3f(loc(water_prog, "u_sun_dir"), sun.x(), sun.y(), sun.z());
+  const int ripples = static_cast<int>(ripple_phase.size());
+  glUniform1i(loc(water_prog, "u_ripple_count"), ripples);
+  if (ripples > 0) {
+    glUniform4fv(loc(water_prog, "u_ripple"), ripples, ripple_a.data());
+    glUniform1fv(loc(water_prog, "u_ripple_phase"), ripples, ripple_phase.data());
+  }
+  glUniform2f(loc(water_prog, "u_focal"), static_cast<float>(rig.camera.fx),
+              static_cast<float>(rig.camera.fy));
+  glUniform1f(loc(water_prog, "u_refl_max_lod"), static_cast<float>(refl_levels - 1));
   glUniform1i(loc(water_prog, "u_reflection"), 0);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, reflection);
@@ -776,6 +889,10 @@ void StereoRenderer::Impl::draw_eye(const SE3& T_W_C, double t, int eye_index) {
     glEnable(GL_CLIP_DISTANCE0);
     draw_scene(view, eye, -1.f, 0);
     glDisable(GL_CLIP_DISTANCE0);
+    if (!ripple_phase.empty()) {
+      glBindTexture(GL_TEXTURE_2D, e.refl_tex);
+      glGenerateMipmap(GL_TEXTURE_2D);
+    }
   }
   glBindFramebuffer(GL_FRAMEBUFFER, e.msaa_fbo);
   glViewport(0, 0, W, H);

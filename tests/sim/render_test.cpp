@@ -6,7 +6,9 @@
 #include <numbers>
 
 #include "core/error.hpp"
+#include "core/rng.hpp"
 #include "core/rotation.hpp"
+#include "sim/waves/wave_field.hpp"
 
 namespace driftlab::sim {
 namespace {
@@ -173,6 +175,73 @@ TEST_F(RenderTest, RepeatedRendersAreByteIdentical) {
   for (int x = 0; x < 640; ++x) lower_nonzero += a.left.at(x, 470) > 0;
   EXPECT_GT(lower_nonzero, 600);
   renderer_->set_waves({});
+}
+
+TEST_F(RenderTest, WindRipplesBreakTheMirrorImageOnlyOnTheWater) {
+  // A bright textured disc above dark water: its mirror image lies below the
+  // horizon. Ripples move and blur the mirror image; the disc itself, above
+  // the horizon, keeps every byte; with the ripples gone again the frame is
+  // the calm frame byte for byte.
+  SceneGeometry s = dark_scene();
+  s.lighting = Lighting{};
+  s.water.enabled = true;
+  Texture t;
+  t.name = "checker";
+  t.width = t.height = 64;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      t.pixels.push_back(static_cast<std::uint8_t>(((x / 8 + y / 8) % 2) ? 220 : 30));
+  s.textures.push_back(t);
+  Mesh m = disc(Vec3(8, 0, -1.5), 1.2);
+  m.material.texture = 0;
+  for (auto& v : m.vertices) {
+    v.u = v.y;
+    v.v = v.z;
+  }
+  s.meshes.push_back(m);
+  renderer_->upload(s);
+  renderer_->set_waves({});
+  const SE3 T_W_C = camera_at(Vec3(0, 0, -0.5));
+  const StereoImages calm = renderer_->render(T_W_C, 2.0, false);
+  WindOptions w;
+  w.speed_mps = 3.0;
+  renderer_->set_ripples(wind_ripples(w, RngStreams(3).stream("water.ripples")));
+  const StereoImages rippled = renderer_->render(T_W_C, 2.0, false);
+  const StereoImages later = renderer_->render(T_W_C, 2.5, false);
+  const StereoImages rippled_again = renderer_->render(T_W_C, 2.0, false);
+  renderer_->set_ripples({});
+  const StereoImages calm_again = renderer_->render(T_W_C, 2.0, false);
+  EXPECT_EQ(calm.left.pixels, calm_again.left.pixels);
+  EXPECT_EQ(rippled.left.pixels, rippled_again.left.pixels);
+  // Rows 0..239 look above the horizon (row 239.5 is level with the camera):
+  // not a byte changes there.
+  const int W = 640;
+  int above_diff = 0;
+  for (int y = 0; y < 236; ++y)
+    for (int x = 0; x < W; ++x) above_diff += calm.left.at(x, y) != rippled.left.at(x, y);
+  EXPECT_EQ(above_diff, 0);
+  // The disc's mirror image (columns 260-380, rows 300-420) against open
+  // water beside it (columns 40-160): the ripples break it up (it differs
+  // from the calm mirror image) and move (it differs from frame to frame),
+  // but a darker image of the disc is still there.
+  double changed = 0, moving = 0, n = 0;
+  double calm_in = 0, calm_out = 0, rippled_in = 0, rippled_out = 0;
+  for (int y = 300; y < 420; ++y)
+    for (int x = 260; x < 380; ++x) {
+      changed += std::abs(calm.left.at(x, y) - rippled.left.at(x, y));
+      moving += rippled.left.at(x, y) != later.left.at(x, y);
+      calm_in += calm.left.at(x, y);
+      rippled_in += rippled.left.at(x, y);
+      calm_out += calm.left.at(x - 220, y);
+      rippled_out += rippled.left.at(x - 220, y);
+      n += 1;
+    }
+  EXPECT_GT(changed / n, 4.0);
+  EXPECT_GT(moving / n, 0.5);
+  const double calm_contrast = (calm_out - calm_in) / n,
+               rippled_contrast = (rippled_out - rippled_in) / n;
+  EXPECT_GT(calm_contrast, 10.0);
+  EXPECT_GT(rippled_contrast, calm_contrast / 3);
 }
 
 TEST(Render, BadRigIsAClearError) {
