@@ -153,8 +153,17 @@ struct LensDistortionOptions {
   }
 };
 
+/// Stereo cameras of the source papers. `custom` leaves every field as given.
+enum class CameraPreset { kCustom, kBumblebee2, kPs3Eye };
+constexpr auto enum_table(CameraPreset) {
+  return std::array{std::pair{CameraPreset::kCustom, "custom"},
+                    std::pair{CameraPreset::kBumblebee2, "bumblebee2"},
+                    std::pair{CameraPreset::kPs3Eye, "ps3_eye"}};
+}
+
 /// Rectified pinhole stereo camera (river paper Eq. (1) uses fx, cx, cy and the baseline).
 struct CameraOptions {
+  CameraPreset preset = CameraPreset::kCustom;
   int width_px = 640;
   int height_px = 480;
   double fx_px = 500.0;
@@ -172,8 +181,24 @@ struct CameraOptions {
   LensDistortionOptions lens_distortion;
   ClockOptions clock;
 
+  /// Sets the image size, intrinsics, baseline and frame rate to a preset's
+  /// (the other fields keep their values); kCustom changes nothing.
+  void apply_preset(CameraPreset p);
+
   template <class A>
   void visit(A& a) {
+    a("preset", preset,
+      "A source paper's camera; setting it resets width_px, height_px, fx_px, fy_px, cx_px, "
+      "cy_px, baseline_m and rate_hz to the preset's values, which keys given after it override. "
+      "bumblebee2 (river paper, Kriechbaumer et al. 2015, Sec. 2.1): 1024x768 px, baseline "
+      "0.12 m, 8.2 Hz (the paper's average frame rate), grey; fx = fy = 817 px, the 3.8 mm "
+      "lens on the 4.65 um pixels of its Sony ICX204 sensor (66 deg horizontal field of view; the "
+      "paper does not name the lens, Point Grey sold 2.5, 3.8 and 6 mm). ps3_eye (basin paper, "
+      "Kucic and Valcic 2020, Sec. 2.2): 640x480 px at 20 Hz; fx = fy = 521 px, the PlayStation "
+      "Eye's wide 75 deg (diagonal) zoom setting; baseline 0.06 m (the paper gives none)");
+    a.when_reading([this] {
+      if (preset != applied_preset_) apply_preset(preset);
+    });
     a("width_px", width_px, "Image width [px]", yaml::in_range(1, 16384));
     a("height_px", height_px, "Image height [px]", yaml::in_range(1, 16384));
     a("fx_px", fx_px, "Focal length along x [px]", yaml::positive());
@@ -205,7 +230,37 @@ struct CameraOptions {
     a("clock", clock, "Frame time stamps: offset, jitter, dropped frames");
     ClockOptions::require_ordered(a, clock, rate_hz);
   }
+
+ private:
+  CameraPreset applied_preset_ = CameraPreset::kCustom;
 };
+
+inline void CameraOptions::apply_preset(CameraPreset p) {
+  switch (p) {
+    case CameraPreset::kCustom:
+      break;
+    case CameraPreset::kBumblebee2:
+      width_px = 1024;
+      height_px = 768;
+      fx_px = fy_px = 817.0;  // 3.8 mm / 4.65 um
+      baseline_m = 0.12;
+      rate_hz = 8.2;
+      break;
+    case CameraPreset::kPs3Eye:
+      width_px = 640;
+      height_px = 480;
+      fx_px = fy_px = 521.0;  // 400 px half diagonal / tan(75 deg / 2)
+      baseline_m = 0.06;
+      rate_hz = 20.0;
+      break;
+  }
+  if (p != CameraPreset::kCustom) {
+    cx_px = (width_px - 1) / 2.0;
+    cy_px = (height_px - 1) / 2.0;
+  }
+  preset = p;
+  applied_preset_ = p;
+}
 
 /// Units of datasheet figures: degrees and standard gravity (g, ug). The same
 /// value as sim::kGravity_m_s2 (checked in imu.cpp), repeated here so that the

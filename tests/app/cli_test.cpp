@@ -1,5 +1,6 @@
 // Runs the `driftlab` executable as a user would and checks exit codes,
 // messages and files written.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <nlohmann/json.hpp>
@@ -184,7 +185,16 @@ TEST(Cli, ASweepPlanOfAScenarioFileSaysWhatASweepNeeds) {
   EXPECT_NE(r.err.find(file + ": base: missing, expected the path of the base scenario"),
             std::string::npos)
       << r.err;
-  EXPECT_NE(r.err.find(file + ":13:1: scene: unknown key"), std::string::npos) << r.err;
+  // The line of the scenario's `scene:` key.
+  std::ifstream in(file);
+  std::string line;
+  int scene_line = 0;
+  for (int n = 1; std::getline(in, line); ++n)
+    if (line.rfind("scene:", 0) == 0) scene_line = n;
+  ASSERT_GT(scene_line, 0);
+  EXPECT_NE(r.err.find(fmt::format("{}:{}:1: scene: unknown key", file, scene_line)),
+            std::string::npos)
+      << r.err;
   EXPECT_FALSE(fs::exists(dir / "out"));
   fs::remove_all(dir);
 }

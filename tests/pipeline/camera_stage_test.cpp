@@ -171,7 +171,7 @@ TEST(CameraStage, AutoExposureSettlesOnTheTargetMean) {
   // (a little off where pixels clip).
   EXPECT_NEAR(stage.exposure_ms(), 5.0 * 80.0 / reference_mean, 0.05 * 5.0 * 80.0 / reference_mean);
   // Bad options name the field.
-  sc.sensors.camera.auto_exposure.max_exposure_ms = 100;  // longer than 1 / 13 Hz
+  sc.sensors.camera.auto_exposure.max_exposure_ms = 1.5e3 / sc.sensors.camera.rate_hz;  // > 1 frame
   EXPECT_THROW(validate_scenario(sc, "test"), UserError);
 }
 

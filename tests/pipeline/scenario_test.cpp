@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <set>
 
 #include "core/error.hpp"
@@ -43,6 +45,38 @@ TEST(Scenario, LoadsTheDemoScenario) {
   EXPECT_FALSE(s.pipeline.sparse.keyframes);
   EXPECT_TRUE(s.pipeline.sparse_kf.keyframes);
   EXPECT_DOUBLE_EQ(s.eval.section_length_m, 6.5);
+}
+
+TEST(Scenario, CameraPresetsAreThePapersCamerasAndLaterKeysOverrideThem) {
+  // River paper Sec. 2.1: Bumblebee2, 1024x768, 0.12 m, 8.2 Hz; 3.8 mm lens on 4.65 um pixels.
+  const Scenario river = load_scenario(kSource / "scenarios/river_crossing.yaml");
+  const sim::CameraOptions& c = river.sensors.camera;
+  EXPECT_EQ(c.preset, sim::CameraPreset::kBumblebee2);
+  EXPECT_EQ(c.width_px, 1024);
+  EXPECT_EQ(c.height_px, 768);
+  EXPECT_NEAR(c.fx_px, 3.8e-3 / 4.65e-6, 0.5);
+  EXPECT_EQ(c.fy_px, c.fx_px);
+  EXPECT_DOUBLE_EQ(c.cx_px, 511.5);
+  EXPECT_DOUBLE_EQ(c.cy_px, 383.5);
+  EXPECT_DOUBLE_EQ(c.baseline_m, 0.12);
+  EXPECT_DOUBLE_EQ(c.rate_hz, 8.2);
+  EXPECT_NEAR(2 * std::atan(512 / c.fx_px) * 180 / std::numbers::pi, 64.1, 0.1);
+  EXPECT_EQ(load_scenario(kSource / "scenarios/river_survey.yaml").sensors.camera.preset,
+            sim::CameraPreset::kBumblebee2);
+  // Basin paper Sec. 2.2: PlayStation Eye pair, 640x480 at 20 Hz; 75 deg diagonal field of view.
+  const sim::CameraOptions b = load_scenario(kSource / "scenarios/basin_exp1.yaml").sensors.camera;
+  EXPECT_EQ(b.preset, sim::CameraPreset::kPs3Eye);
+  EXPECT_EQ(b.width_px, 640);
+  EXPECT_NEAR(2 * std::atan(400 / b.fx_px) * 180 / std::numbers::pi, 75.0, 0.1);
+  EXPECT_DOUBLE_EQ(b.rate_hz, 20.0);
+  // Keys after the preset override it; custom leaves the defaults.
+  const Scenario o = parse_scenario(
+      "sensors:\n  camera:\n    preset: bumblebee2\n    rate_hz: 15\n", "o", kSource);
+  EXPECT_EQ(o.sensors.camera.width_px, 1024);
+  EXPECT_DOUBLE_EQ(o.sensors.camera.rate_hz, 15.0);
+  const Scenario d = parse_scenario("sensors:\n  camera:\n    preset: custom\n", "d", kSource);
+  EXPECT_EQ(d.sensors.camera.width_px, sim::CameraOptions{}.width_px);
+  EXPECT_EQ(d.sensors.camera.fx_px, sim::CameraOptions{}.fx_px);
 }
 
 TEST(Scenario, BasinExperimentsMatchThePaperTable) {
