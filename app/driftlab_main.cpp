@@ -23,9 +23,11 @@
 #include "core/error.hpp"
 #include "core/trajectory_io.hpp"
 #include "eval/evaluate.hpp"
+#include "gate/gate.hpp"
 #include "pipeline/render_stage.hpp"
 #include "pipeline/run.hpp"
 #include "pipeline/scenario.hpp"
+#include "report/paper_compare.hpp"
 
 #ifndef DRIFTLAB_VERSION
 #define DRIFTLAB_VERSION "unknown"
@@ -83,6 +85,32 @@ struct EvalArgs {
   int align_first_n = 0;
   bool force = false;
 };
+
+// `driftlab paper RUN`: the river paper's Tables 1-4 next to the run's.
+int paper_command(const std::string& run, const std::string& track_name, const std::string& out) {
+  namespace report = driftlab::report;
+  const nlohmann::json metrics =
+      driftlab::gate::read_results_metrics(driftlab::gate::find_results_metrics(run));
+  std::optional<report::RiverPaperTrack> track;
+  if (track_name == "discharge") track = report::RiverPaperTrack::kDischarge;
+  if (track_name == "total") track = report::RiverPaperTrack::kTotal;
+  if (!track_name.empty() && !track)
+    throw driftlab::app::UsageError(
+        fmt::format("--track: got '{}', expected discharge or total", track_name));
+  const std::string scenario = metrics.value("scenario", std::string());
+  if (!track) track = report::river_paper_track_of(scenario);
+  if (!track)
+    throw driftlab::app::UsageError(fmt::format(
+        "{}: scenario '{}' is not a twin of the river paper (river_crossing, river_survey); "
+        "say which row of its Table 2 to compare with: --track discharge|total",
+        run, scenario));
+  const std::string text = report::river_paper_side_by_side(metrics, *track);
+  if (out.empty())
+    std::cout << text;
+  else
+    driftlab::write_file_atomic(out, text);
+  return 0;
+}
 
 int eval_command(const EvalArgs& a) {
   namespace eval = driftlab::eval;
@@ -219,6 +247,15 @@ int driftlab_main(int argc, char** argv) {
   eval_cmd->add_option("--out", ev.out, "Output folder (written atomically)")->required();
   eval_cmd->add_flag("--force", ev.force, "Replace an existing output folder");
 
+  std::string paper_run, paper_track, paper_out;
+  auto* paper_cmd = app.add_subcommand(
+      "paper", "The river paper's Tables 1-4 next to a run's (river_crossing, river_survey)");
+  paper_cmd->add_option("RUN", paper_run, "Run folder or its metrics.json")->required();
+  paper_cmd->add_option("--track", paper_track,
+                        "Row of the paper's Table 2: discharge (four crossings) or total (the "
+                        "survey); default: from the run's scenario name");
+  paper_cmd->add_option("--out", paper_out, "Write the Markdown to this file (default: stdout)");
+
   // export, vo: datasets out and in.
   driftlab::app::DatasetCommands dataset_commands(app);
 
@@ -248,6 +285,7 @@ int driftlab_main(int argc, char** argv) {
       return 0;
     }
     if (eval_cmd->parsed()) return eval_command(ev);
+    if (paper_cmd->parsed()) return paper_command(paper_run, paper_track, paper_out);
     return 0;
   });
 }

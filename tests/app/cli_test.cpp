@@ -290,3 +290,32 @@ TEST(CliRender, SameBytesWithOneOrTwoRasterThreads) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Cli, PaperPutsTheRiverPaperBesideARunAndAsksForTheTrackOfOtherScenarios) {
+  const fs::path dir = fresh_temp_dir("paper");
+  const fs::path metrics = dir / "metrics.json";
+  nlohmann::json m;
+  m["scenario"] = "my_reach";
+  m["algorithms"]["sparse"]["sections"]["p_m_per_m"]["mean"] = 0.0123;
+  std::ofstream(metrics) << m.dump();
+  Result r = run_cli({"paper", metrics.string()});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.err.find("scenario 'my_reach' is not a twin of the river paper"), std::string::npos)
+      << r.err;
+  r = run_cli({"paper", dir.string(), "--track", "sideways"});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.err.find("--track: got 'sideways', expected discharge or total"), std::string::npos)
+      << r.err;
+  r = run_cli({"paper", dir.string(), "--track", "total", "--out", (dir / "paper.md").string()});
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  const std::string text = slurp(dir / "paper.md");
+  EXPECT_NE(text.find("| Mean | 0.067 | 0.012 | 0.177 |"), std::string::npos) << text;
+  EXPECT_NE(text.find("13.36 (2.01)"), std::string::npos);
+  r = run_cli({"paper", (dir / "missing").string()});
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  fs::remove_all(dir);
+}
+
+}  // namespace
