@@ -62,6 +62,29 @@ Mesh disc(const Vec3& c, double radius, int segments = 64) {
   return m;
 }
 
+// A disc with an 8 x 8 checkerboard of grey levels `dark` and `bright` over
+// water, lit by the default (overcast) light.
+SceneGeometry checker_disc_over_water(const Vec3& centre, double radius, std::uint8_t dark,
+                                      std::uint8_t bright) {
+  SceneGeometry s = dark_scene();
+  s.lighting = Lighting{};
+  s.water.enabled = true;
+  Texture t;
+  t.name = "checker";
+  t.width = t.height = 64;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) t.pixels.push_back(((x / 8 + y / 8) % 2) ? bright : dark);
+  s.textures.push_back(t);
+  Mesh m = disc(centre, radius);
+  m.material.texture = 0;
+  for (auto& v : m.vertices) {
+    v.u = v.y;
+    v.v = v.z;
+  }
+  s.meshes.push_back(m);
+  return s;
+}
+
 // Intensity-weighted centroid of an image.
 Eigen::Vector2d centroid(const GrayImage& img) {
   double sx = 0, sy = 0, s = 0;
@@ -145,24 +168,7 @@ TEST_F(RenderTest, GroundTruthDepthOfAWallIsItsDistance) {
 }
 
 TEST_F(RenderTest, RepeatedRendersAreByteIdentical) {
-  SceneGeometry s = dark_scene();
-  s.lighting = Lighting{};
-  s.water.enabled = true;
-  Texture t;
-  t.name = "checker";
-  t.width = t.height = 64;
-  for (int y = 0; y < 64; ++y)
-    for (int x = 0; x < 64; ++x)
-      t.pixels.push_back(static_cast<std::uint8_t>(((x / 8 + y / 8) % 2) ? 200 : 40));
-  s.textures.push_back(t);
-  Mesh m = disc(Vec3(8, 1, -1), 1.5);
-  m.material.texture = 0;
-  for (auto& v : m.vertices) {
-    v.u = v.y;
-    v.v = v.z;
-  }
-  s.meshes.push_back(m);
-  renderer_->upload(s);
+  renderer_->upload(checker_disc_over_water(Vec3(8, 1, -1), 1.5, 40, 200));
   WaveComponent w{0.02, 2 * std::numbers::pi / 1.5, 3.0, 0.3, 0.1};
   renderer_->set_waves({w});
   const StereoImages a = renderer_->render(camera_at(Vec3(0, 0, -0.5)), 1.25, true);
@@ -182,24 +188,7 @@ TEST_F(RenderTest, WindRipplesBreakTheMirrorImageOnlyOnTheWater) {
   // horizon. Ripples move and blur the mirror image; the disc itself, above
   // the horizon, keeps every byte; with the ripples gone again the frame is
   // the calm frame byte for byte.
-  SceneGeometry s = dark_scene();
-  s.lighting = Lighting{};
-  s.water.enabled = true;
-  Texture t;
-  t.name = "checker";
-  t.width = t.height = 64;
-  for (int y = 0; y < 64; ++y)
-    for (int x = 0; x < 64; ++x)
-      t.pixels.push_back(static_cast<std::uint8_t>(((x / 8 + y / 8) % 2) ? 220 : 30));
-  s.textures.push_back(t);
-  Mesh m = disc(Vec3(8, 0, -1.5), 1.2);
-  m.material.texture = 0;
-  for (auto& v : m.vertices) {
-    v.u = v.y;
-    v.v = v.z;
-  }
-  s.meshes.push_back(m);
-  renderer_->upload(s);
+  renderer_->upload(checker_disc_over_water(Vec3(8, 0, -1.5), 1.2, 30, 220));
   renderer_->set_waves({});
   const SE3 T_W_C = camera_at(Vec3(0, 0, -0.5));
   const StereoImages calm = renderer_->render(T_W_C, 2.0, false);
