@@ -175,6 +175,40 @@ cv::Mat draw_matches(const vo::StereoFrame& frame, std::span<const vo::SparseMat
   return out;
 }
 
+// Each filter's estimate against its raw VO's, by APE translation RMSE (the same evaluation,
+// the same frames): `vs_raw_vo` in the filter's metrics, a report table, and a warning for each
+// filter that is worse than the VO it filters, so that a filter that does not help says so.
+std::string compare_filters_with_raw_vo(const std::vector<Track>& tracks, nlohmann::json* metrics,
+                                        std::vector<std::string>* warnings) {
+  std::string table;
+  for (const Track& tr : tracks) {
+    if (tr.vo || tr.external) continue;
+    const std::string& raw = tracks[tr.source].name;
+    auto& algorithms = (*metrics)["algorithms"];
+    const auto& f = algorithms[tr.name]["ape"]["trans_m"]["rmse"];
+    const auto& r = algorithms[raw]["ape"]["trans_m"]["rmse"];
+    if (!f.is_number() || !r.is_number()) continue;  // no associated poses
+    const double filtered_m = f.get<double>(), raw_m = r.get<double>();
+    const bool better = filtered_m < raw_m;
+    algorithms[tr.name]["vs_raw_vo"] = {{"raw_vo", raw},
+                                        {"metric", "ape.trans_m.rmse"},
+                                        {"filtered", filtered_m},
+                                        {"raw", raw_m},
+                                        {"ratio", raw_m > 0 ? filtered_m / raw_m : 0.0},
+                                        {"better", better}};
+    if (!better)
+      warnings->push_back(fmt::format(
+          "{} is no better than its raw VO {}: APE translation RMSE {:.4g} m against {:.4g} m",
+          tr.name, raw, filtered_m, raw_m));
+    table += fmt::format("| {} | {} | {:.4g} | {:.4g} | {:.2f} | {} |\n", tr.name, raw, filtered_m,
+                         raw_m, raw_m > 0 ? filtered_m / raw_m : 0.0, better ? "yes" : "**no**");
+  }
+  if (table.empty()) return "";
+  return "## Filters against their raw VO\n\n| filter | raw VO | APE trans. RMSE (m) | raw VO's "
+         "(m) | ratio | better |\n|---|---|---|---|---|---|\n" +
+         table + "\n";
+}
+
 // The constant-acceleration smoother with its backward pass over the delivered frames of VO
 // track `track` (index `source`), anchored where the VO's estimate starts.
 Track rts_smoothed(const Track& track, std::size_t source,
@@ -385,6 +419,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
           tr.vo_ms / static_cast<double>(camera_gt.size());
   }
   write_file_atomic(dir / "sections.csv", sections);
+  report += compare_filters_with_raw_vo(tracks, metrics, &warnings);
 
   // Report: plots (gnuplot) and the same report as HTML.
   std::vector<report::NamedTrajectory> named;

@@ -1,5 +1,6 @@
 #include "pipeline/run.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -292,6 +293,42 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
 
 namespace driftlab::pipeline {
 namespace {
+
+TEST(Run, EachFilterIsSetAgainstItsRawVoAndOneThatDoesNotHelpSaysSo) {
+  const fs::path out = temp_dir("filters_vs_vo");
+  Scenario sc = load_scenario(kSource / "scenarios/basin_exp4.yaml");
+  sc.pipeline.max_frames = 80;
+  sc.pipeline.vo = {"pnp"};
+  sc.pipeline.fusion = {FusionAlgorithm::kCaSmoother, FusionAlgorithm::kNedKf,
+                        FusionAlgorithm::kNedPf};
+  run_scenario(sc, out, {});
+  const auto m = nlohmann::json::parse(slurp(out / "metrics.json"));
+  const std::string report = slurp(out / "report.md");
+  EXPECT_NE(report.find("## Filters against their raw VO"), std::string::npos);
+  const double raw = m["algorithms"]["pnp"]["ape"]["trans_m"]["rmse"].get<double>();
+  EXPECT_FALSE(m["algorithms"]["pnp"].contains("vs_raw_vo"));  // a VO is not a filter
+  for (const char* f : {"pnp_ca", "pnp_ned_kf", "pnp_ned_pf"}) {
+    SCOPED_TRACE(f);
+    const auto& a = m["algorithms"][f];
+    const double filtered = a["ape"]["trans_m"]["rmse"].get<double>();
+    ASSERT_TRUE(a.contains("vs_raw_vo"));
+    EXPECT_EQ(a["vs_raw_vo"]["raw_vo"], "pnp");
+    EXPECT_EQ(a["vs_raw_vo"]["filtered"].get<double>(), filtered);
+    EXPECT_EQ(a["vs_raw_vo"]["raw"].get<double>(), raw);
+    const bool better = filtered < raw;
+    EXPECT_EQ(a["vs_raw_vo"]["better"].get<bool>(), better);
+    bool warned = false;
+    for (const auto& w : m["warnings"])
+      warned = warned || w.get<std::string>().rfind(std::string(f) +
+                                                        " is no better than its "
+                                                        "raw VO pnp",
+                                                    0) == 0;
+    EXPECT_EQ(warned, !better);
+    EXPECT_NE(report.find(fmt::format("| {} | pnp | {:.4g} | {:.4g} |", f, filtered, raw)),
+              std::string::npos);
+  }
+  fs::remove_all(out);
+}
 
 TEST(Run, StagesSayWhatRanAndTheBackwardPassWritesItsOwnEstimate) {
   const fs::path a = temp_dir("stages_a"), b = temp_dir("stages_b");
