@@ -503,14 +503,21 @@ Trajectory read_euroc_groundtruth(const fs::path& path) {
 }
 
 void write_euroc_groundtruth(const fs::path& path, const Trajectory& trajectory,
-                             const std::vector<Vec3>& velocities_W_m_s) {
+                             const std::vector<Vec3>& velocities_W_m_s,
+                             const std::vector<ImuBias>& biases) {
   demand_writable(trajectory);
-  const bool with_velocity = !velocities_W_m_s.empty();
+  const bool with_velocity = !velocities_W_m_s.empty(), with_bias = !biases.empty();
   DRIFTLAB_DEMAND_MSG(!with_velocity || velocities_W_m_s.size() == trajectory.size(),
                       "write_euroc_groundtruth: one velocity per pose");
+  DRIFTLAB_DEMAND_MSG(!with_bias || (with_velocity && biases.size() == trajectory.size()),
+                      "write_euroc_groundtruth: one bias per pose, after the velocities");
   std::string text =
       "#timestamp,p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []";
   if (with_velocity) text += ",v_RS_R_x [m s^-1],v_RS_R_y [m s^-1],v_RS_R_z [m s^-1]";
+  if (with_bias)
+    text +=
+        ",b_w_RS_S_x [rad s^-1],b_w_RS_S_y [rad s^-1],b_w_RS_S_z [rad s^-1],"
+        "b_a_RS_S_x [m s^-2],b_a_RS_S_y [m s^-2],b_a_RS_S_z [m s^-2]";
   text += '\n';
   for (std::size_t i = 0; i < trajectory.size(); ++i) {
     const Vec3& p = trajectory[i].T_W_C.translation();
@@ -521,6 +528,13 @@ void write_euroc_groundtruth(const fs::path& path, const Trajectory& trajectory,
       const Vec3& v = velocities_W_m_s[i];
       DRIFTLAB_DEMAND_MSG(v.allFinite(), fmt::format("velocity {} is not finite", i));
       append_values(&text, {v.x(), v.y(), v.z()}, ',');
+    }
+    if (with_bias) {
+      const ImuBias& b = biases[i];
+      DRIFTLAB_DEMAND_MSG(b.gyro.allFinite() && b.accel.allFinite(),
+                          fmt::format("bias {} is not finite", i));
+      append_values(
+          &text, {b.gyro.x(), b.gyro.y(), b.gyro.z(), b.accel.x(), b.accel.y(), b.accel.z()}, ',');
     }
     text += '\n';
   }

@@ -92,10 +92,18 @@ void write_kitti_times(const std::filesystem::path& path, const Trajectory& traj
 /// "#timestamp,p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []"
 /// and any further columns (velocities, biases), which are ignored.
 Trajectory read_euroc_groundtruth(const std::filesystem::path& path);
+/// IMU biases at a ground-truth pose: gyroscope [rad/s] and accelerometer [m/s^2], in S.
+struct ImuBias {
+  Vec3 gyro = Vec3::Zero();
+  Vec3 accel = Vec3::Zero();
+};
+
 /// Writes the 8 pose columns, plus v_RS_R_{x,y,z} [m s^-1] when `velocities_W_m_s` is
-/// non-empty (then one per pose).
+/// non-empty (then one per pose), plus EuRoC's b_w_RS_S_{x,y,z} [rad s^-1] and
+/// b_a_RS_S_{x,y,z} [m s^-2] when `biases` is non-empty (then one per pose, and velocities too).
 void write_euroc_groundtruth(const std::filesystem::path& path, const Trajectory& trajectory,
-                             const std::vector<Vec3>& velocities_W_m_s = {});
+                             const std::vector<Vec3>& velocities_W_m_s = {},
+                             const std::vector<ImuBias>& biases = {});
 
 /// "#timestamp [ns],w_RS_S_x [rad s^-1],...,a_RS_S_z [m s^-2]": exactly 7 columns.
 std::vector<ImuSample> read_euroc_imu(const std::filesystem::path& path);

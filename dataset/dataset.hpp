@@ -60,6 +60,7 @@ struct BodyState {
   TimeNs t_ns = 0;
   SE3 T_W_S;
   Vec3 v_W = Vec3::Zero();
+  std::optional<ImuBias> bias;  ///< the simulated IMU's biases at t_ns (when it has one)
 };
 
 /// Ground truth and the other sensors, handed to a writer once every frame is in.

@@ -76,8 +76,8 @@ std::string info_yaml(const ExportCalibration& cal, std::size_t frames) {
       "  mav0/imu0/data.csv: angular rate [rad/s] and specific force [m/s^2] in the IMU frame\n"
       "  mav0/imu0/sensor.yaml: the IMU's Kalibr noise model\n"
       "  mav0/state_groundtruth_estimate0/data.csv: true body pose in the world (p_RS_R, "
-      "q_RS), velocity v_RS_R, at most 200 Hz; no bias columns (the simulated biases are not "
-      "exported yet)\n"
+      "q_RS), velocity v_RS_R and the simulated IMU's biases b_w_RS_S, b_a_RS_S, at most "
+      "200 Hz\n"
       "  mav0/gps0/data.csv, mav0/compass0/data.csv: driftlab's own GPS and compass CSVs\n"
       "  scenario.resolved.yaml: the scenario that made this dataset\n",
       cal.source, frames, yaml::format_double(cal.camera_rate_hz), cal.rig.baseline_m);
@@ -109,12 +109,17 @@ class EurocWriter final : public DatasetWriter {
     }
     Trajectory body;
     std::vector<Vec3> velocities;
+    std::vector<ImuBias> biases;  // only when every state has one
+    const bool with_bias = std::all_of(truth.body.begin(), truth.body.end(),
+                                       [](const BodyState& b) { return b.bias.has_value(); });
     for (const BodyState& b : truth.body) {
       body.push_back({b.t_ns, b.T_W_S});
       velocities.push_back(b.v_W);
+      if (with_bias) biases.push_back(*b.bias);
     }
     fs::create_directories(mav_ / "state_groundtruth_estimate0");
-    write_euroc_groundtruth(mav_ / "state_groundtruth_estimate0" / "data.csv", body, velocities);
+    write_euroc_groundtruth(mav_ / "state_groundtruth_estimate0" / "data.csv", body, velocities,
+                            biases);
     for (const auto& csv : truth.sensor_csvs)
       move_file(csv, mav_ / (csv.stem().string() + "0") / "data.csv");
     if (fs::exists(mav_ / "imu0" / "data.csv"))

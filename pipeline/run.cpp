@@ -493,12 +493,14 @@ MissionTruth simulate_mission(const Scenario& sc,
     if (!imu_states || step++ % every) return;
     const Vec3 v_S_B = b.state.v_B + b.state.w_B.cross(T_B_S.translation());
     truth.imu_states.push_back(
-        {b.t_ns, b.state.T_W_B() * T_B_S, b.state.q_W_B.toRotationMatrix() * v_S_B});
+        {b.t_ns, b.state.T_W_B() * T_B_S, b.state.q_W_B.toRotationMatrix() * v_S_B, {}});
   };
   truth.motion = sensors ? simulate_scenario_motion(
                                sc, physics, on_frame, sensors->sample_times(motion_end_s(sc)),
                                [&](const sim::BodySample& b) { sensors->on_sample(b); })
                          : simulate_scenario_motion(sc, physics, on_frame);
+  if (sensors)
+    for (dataset::BodyState& s : truth.imu_states) s.bias = sensors->imu_bias_at(s.t_ns);
   return truth;
 }
 

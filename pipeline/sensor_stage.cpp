@@ -38,6 +38,7 @@ struct SensorStage::Impl {
   std::vector<TimeNs> imu_times, gps_times, compass_times;
   std::size_t imu_next = 0, gps_next = 0, compass_next = 0;
   std::vector<sim::BodySample> gps_bodies, compass_bodies;
+  std::vector<std::pair<TimeNs, ImuBias>> imu_biases;  // after each IMU sample, dropped ones too
   SensorData data;
 
   Impl(const Scenario& s, const std::filesystem::path& d) : sc(s), dir(d), rng(s.seed) {
@@ -77,9 +78,18 @@ void SensorStage::on_sample(const sim::BodySample& b) {
       s.imu_csv->write(*m);
       s.data.imu.push_back(*m);
     }
+    s.imu_biases.push_back({b.t_ns, {s.imu->gyro().bias, s.imu->accel().bias}});
   }
   if (take(s.gps_times, &s.gps_next, b.t_ns)) s.gps_bodies.push_back(b);
   if (take(s.compass_times, &s.compass_next, b.t_ns)) s.compass_bodies.push_back(b);
+}
+
+std::optional<ImuBias> SensorStage::imu_bias_at(TimeNs t_ns) const {
+  const auto& h = impl_->imu_biases;
+  if (h.empty()) return std::nullopt;
+  auto it = std::upper_bound(h.begin(), h.end(), t_ns,
+                             [](TimeNs t, const auto& sample) { return t < sample.first; });
+  return it == h.begin() ? h.front().second : std::prev(it)->second;
 }
 
 SensorData SensorStage::finish(const sim::SceneGeometry* scene) {

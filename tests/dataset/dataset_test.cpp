@@ -58,7 +58,7 @@ struct Sequence {
       depth.push_back(d);
       const SE3 T(quat_from_euler_zyx({0.01 * i, 0.02, 0.5 + 0.1 * i}), Vec3(3 + i, 2 * i, -1));
       truth.camera.push_back({stamps[i], T});
-      truth.body.push_back({stamps[i], T * calibration().T_S_C.inverse(), Vec3(1, 0, 0)});
+      truth.body.push_back({stamps[i], T * calibration().T_S_C.inverse(), Vec3(1, 0, 0), {}});
     }
   }
   void write(DatasetWriter& w) const {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -146,6 +147,62 @@ INSTANTIATE_TEST_SUITE_P(Formats, ExportRoundTrip,
                            return std::string(
                                info.param == dataset::DatasetFormat::kKitti ? "Kitti" : "Euroc");
                          });
+
+// EuRoC's ground truth rows of an export: t_ns and the numbers after it.
+std::map<TimeNs, std::vector<double>> euroc_rows(const fs::path& csv) {
+  std::istringstream in(slurp(csv));
+  std::string line;
+  std::getline(in, line);  // header
+  std::map<TimeNs, std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    const auto cells = split_csv_line(line);
+    std::vector<double> values;
+    for (std::size_t i = 1; i < cells.size(); ++i) values.push_back(std::stod(cells[i]));
+    rows[std::stoll(cells[0])] = values;
+  }
+  return rows;
+}
+
+TEST(Export, EurocGroundTruthCarriesTheSimulatedImusBiases) {
+  // A noise-free IMU whose biases walk: its reading is the true one plus the bias, so the
+  // difference from the same IMU without biases is the bias at that sample, which the
+  // ground truth's b_w_RS_S and b_a_RS_S columns must give at the same time stamps.
+  const fs::path root = test::unused_temp_path("export_bias");
+  Scenario sc = load_scenario(test::source_dir() / "scenarios/river_crossing.yaml");
+  sc.pipeline.max_frames = 12;
+  sc.sensors.imu.apply_preset(sim::ImuPreset::kIdeal);
+  sc.sensors.imu.gyro_range_rad_s = sc.sensors.imu.accel_range_m_s2 = 0;
+  ExportOptions o;
+  o.format = dataset::DatasetFormat::kEuroc;
+  export_dataset(sc, root / "plain", o);
+  sc.sensors.imu.gyro_turn_on_bias_rad_s = 0.01;
+  sc.sensors.imu.gyro_random_walk_rad_s2_sqrt_hz = 0.002;
+  sc.sensors.imu.accel_turn_on_bias_m_s2 = 0.05;
+  sc.sensors.imu.accel_random_walk_m_s3_sqrt_hz = 0.01;
+  export_dataset(sc, root / "biased", o);
+  const auto plain = euroc_rows(root / "plain/mav0/imu0/data.csv");
+  const auto biased = euroc_rows(root / "biased/mav0/imu0/data.csv");
+  const fs::path gt_csv = root / "biased/mav0/state_groundtruth_estimate0/data.csv";
+  EXPECT_NE(slurp(gt_csv).find(",b_w_RS_S_x [rad s^-1]"), std::string::npos);
+  const auto gt = euroc_rows(gt_csv);
+  std::size_t compared = 0;
+  double first_gyro_bias = 0, last_gyro_bias = 0;
+  for (const auto& [t, row] : gt) {
+    ASSERT_EQ(row.size(), 16u);  // p (3), q (4), v (3), b_w (3), b_a (3)
+    const auto b = biased.find(t), p = plain.find(t);
+    if (b == biased.end() || p == plain.end()) continue;
+    for (int i = 0; i < 6; ++i)  // w_RS_S (3) then a_RS_S (3): the same order as b_w, b_a
+      EXPECT_NEAR(row[10 + i], b->second[i] - p->second[i], 1e-9) << t << " " << i;
+    (compared ? last_gyro_bias : first_gyro_bias) = row[10];
+    ++compared;
+  }
+  EXPECT_GT(compared, 200u);                   // 1.3 s at 200 Hz
+  EXPECT_NE(first_gyro_bias, last_gyro_bias);  // the bias walks
+  // The IMU without biases: columns of zeros.
+  for (const auto& [t, row] : euroc_rows(root / "plain/mav0/state_groundtruth_estimate0/data.csv"))
+    for (int i = 10; i < 16; ++i) EXPECT_EQ(row.at(i), 0.0) << t;
+  fs::remove_all(root);
+}
 
 TEST(ExportCli, WritesEachFormatAndVoReadsIt) {
   const fs::path root = test::unused_temp_path("export_cli");
