@@ -209,6 +209,125 @@ std::string compare_filters_with_raw_vo(const std::vector<Track>& tracks, nlohma
          table + "\n";
 }
 
+// The VO tracks of pipeline.vo (every frame "dropped" until it comes), then for each fusion
+// algorithm one track per VO, following it.
+std::vector<Track> make_tracks(const Scenario& sc, const StereoRig& rig,
+                               const SensorData& sensor_data, const Trajectory& camera_gt,
+                               const RngStreams& rng) {
+  std::vector<Track> tracks;
+  for (const std::string& a : sc.pipeline.vo) {
+    Track t;
+    t.name = a;
+    t.vo = make_vo(a, rig, sc.pipeline, rng);
+    t.results.resize(camera_gt.size());
+    for (auto& r : t.results) r.reason = "frame dropped";
+    tracks.push_back(std::move(t));
+  }
+  const std::size_t n_vo = tracks.size();
+  const SE3 T_W_B0 =
+      camera_gt.front().T_W_C * camera_mount_T_B_C(sc.sensors.camera.mount).inverse();
+  for (FusionAlgorithm f : sc.pipeline.fusion) {
+    for (std::size_t i = 0; i < n_vo; ++i) {
+      Track t;
+      t.source = i;
+      if (f == FusionAlgorithm::kCaSmoother) {
+        t.name = tracks[i].name + "_ca";
+        t.smoother =
+            std::make_unique<fusion::ConstantAccelerationSmoother>(sc.pipeline.ca_smoother);
+      } else {
+        t.name = tracks[i].name + "_" + std::string(yaml::enum_name(f));
+        t.filter = std::make_unique<FilterTrack>(f, sc, sensor_data, T_W_B0, rng);
+      }
+      tracks.push_back(std::move(t));
+    }
+  }
+  return tracks;
+}
+
+// Every track evaluated against the camera ground truth (with the platform's angles and the
+// VO's inliers and depths as the section covariates): metrics.json's algorithms and VO
+// timings, and the tables; each track's sections CSV is appended to *sections.
+std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks,
+                            const MissionTruth& mission, nlohmann::json* metrics,
+                            std::string* sections_csv) {
+  const Trajectory& camera_gt = mission.camera_gt;
+  const std::vector<EulerZYX>& platform = mission.platform;
+  std::string report;
+  std::string& sections = *sections_csv;
+  for (std::size_t i = 0; i < tracks.size(); ++i) {
+    const Track& tr = tracks[i];
+    const Track& src = tr.vo || tr.external ? tr : tracks[tr.source];
+    eval::EvaluationInput in;
+    in.gt = camera_gt;
+    in.est = tr.estimate;
+    in.gt_label = "groundtruth.tum";
+    in.est_label = "estimates/" + tr.name + ".tum";
+    in.algorithm = tr.name;
+    in.options = sc.eval;
+    eval::FrameTable ft;
+    ft.names = {"yaw_deg", "pitch_deg", "roll_deg", "inliers", "mean_depth_m"};
+    ft.columns.resize(5);
+    for (std::size_t k = 0; k < camera_gt.size(); ++k) {
+      ft.t_ns.push_back(camera_gt[k].t_ns);
+      ft.columns[0].push_back(rad2deg(platform[k].yaw_rad));
+      ft.columns[1].push_back(rad2deg(platform[k].pitch_rad));
+      ft.columns[2].push_back(rad2deg(platform[k].roll_rad));
+      const vo::VoResult& r = src.results[k];
+      // Covariate f: inlier features (sparse, river paper Table 4), pixels with valid depth
+      // (dense).
+      const double f = src.name == "dense" ? r.valid_depth_pixels : r.inliers;
+      ft.columns[3].push_back(r.valid ? f : std::numeric_limits<double>::quiet_NaN());
+      ft.columns[4].push_back(r.valid ? r.mean_inlier_depth_m
+                                      : std::numeric_limits<double>::quiet_NaN());
+    }
+    in.frames = ft;
+    const eval::Evaluation e = eval::evaluate(in);
+    (*metrics)["algorithms"][tr.name] = eval::to_json(e, sc.eval);
+    report += eval::tables_markdown(e, sc.eval) + "\n";
+    const std::string csv = eval::sections_csv(e);
+    sections += sections.empty() ? csv : csv.substr(csv.find('\n') + 1);
+    if (tr.vo)
+      (*metrics)["timing"]["vo_ms_per_frame"][tr.name] =
+          tr.vo_ms / static_cast<double>(camera_gt.size());
+  }
+  return report;
+}
+
+// The report: plots (gnuplot), the external VOs' fates, and report.md and report.html with
+// the tables so far (`report`).
+void write_report(const Scenario& sc, const std::vector<Track>& tracks, const Trajectory& camera_gt,
+                  const std::filesystem::path& dir, std::size_t sample_frame,
+                  const std::string& sections, std::string report, const nlohmann::json& metrics,
+                  std::vector<std::string>* warnings) {
+  std::vector<report::NamedTrajectory> named;
+  for (const auto& tr : tracks) named.push_back({tr.name, tr.estimate});
+  report::PlotSet made = report::make_plots(dir, camera_gt, named, sections);
+  if (!made.warning.empty()) warnings->push_back(made.warning);
+  std::vector<report::PlotFile>& plots = made.files;
+  for (const auto& tr : tracks)
+    if (std::filesystem::exists(dir / "plots" / (tr.name + "_matches.png")))
+      plots.push_back({fmt::format("Stereo pair at frame {} with the {} matches: current left "
+                                   "(top) and right (bottom), inliers green, outliers red, flow "
+                                   "from the previous frame in orange (Fig. 3)",
+                                   sample_frame, tr.name),
+                       "plots/" + tr.name + "_matches.png"});
+  if (metrics.contains("external_vo")) {  // every external VO's fate, failures included
+    report +=
+        "## External VOs\n\n| name | status | exit | seconds | message |\n|---|---|---|---|---|\n";
+    for (const auto& [name, r] : metrics["external_vo"].items())
+      report += fmt::format("| {} | {} | {} | {:.2f} | {} |\n", name,
+                            r["status"].get<std::string>(), r["exit"].get<std::string>(),
+                            r["seconds"].get<double>(), r["message"].get<std::string>());
+    report += "\nEach command's output is in external/NAME/log.txt.\n\n";
+  }
+  const std::string tables = report;
+  if (!plots.empty()) report += "## Plots\n\n";
+  for (const auto& p : plots) report += fmt::format("![{}]({})\n\n", p.title, p.file);
+  write_file_atomic(dir / "report.md", report);
+  write_file_atomic(dir / "report.html",
+                    report::report_html("driftlab run: " + sc.name, tables, plots));
+}
+
 // The constant-acceleration smoother with its backward pass over the delivered frames of VO
 // track `track` (index `source`), anchored where the VO's estimate starts.
 Track rts_smoothed(const Track& track, std::size_t source,
@@ -263,34 +382,9 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
 
   // Stages: VO and fusion. VO sees images and the rig only; the pipeline
   // anchors every estimate at the true first pose so that tracks overlay.
-  std::vector<Track> tracks;
+  std::vector<Track> tracks = make_tracks(sc, rig, sensor_data, camera_gt, rng);
   std::vector<std::string> warnings;
-  for (const std::string& a : sc.pipeline.vo) {
-    Track t;
-    t.name = a;
-    t.vo = make_vo(a, rig, sc.pipeline, rng);
-    t.results.resize(camera_gt.size());
-    for (auto& r : t.results) r.reason = "frame dropped";
-    tracks.push_back(std::move(t));
-  }
-  const std::size_t n_vo = tracks.size();
-  const SE3 T_W_B0 =
-      camera_gt.front().T_W_C * camera_mount_T_B_C(sc.sensors.camera.mount).inverse();
-  for (FusionAlgorithm f : sc.pipeline.fusion) {
-    for (std::size_t i = 0; i < n_vo; ++i) {
-      Track t;
-      t.source = i;
-      if (f == FusionAlgorithm::kCaSmoother) {
-        t.name = tracks[i].name + "_ca";
-        t.smoother =
-            std::make_unique<fusion::ConstantAccelerationSmoother>(sc.pipeline.ca_smoother);
-      } else {
-        t.name = tracks[i].name + "_" + std::string(yaml::enum_name(f));
-        t.filter = std::make_unique<FilterTrack>(f, sc, sensor_data, T_W_B0, rng);
-      }
-      tracks.push_back(std::move(t));
-    }
-  }
+  const std::size_t n_vo = sc.pipeline.vo.size();
   std::size_t first = 0;  // the first frame the camera delivers
   while (first < stamps.size() && first < camera_gt.size() && stamps[first].dropped) ++first;
   if (first < camera_gt.size())
@@ -382,73 +476,11 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   // Stage: evaluation of every estimate against the camera ground truth.
   std::string report = fmt::format("# driftlab run: {}\n\n{}\n\n", sc.name, sc.description);
   std::string sections;
-  for (std::size_t i = 0; i < tracks.size(); ++i) {
-    const Track& tr = tracks[i];
-    const Track& src = tr.vo || tr.external ? tr : tracks[tr.source];
-    eval::EvaluationInput in;
-    in.gt = camera_gt;
-    in.est = tr.estimate;
-    in.gt_label = "groundtruth.tum";
-    in.est_label = "estimates/" + tr.name + ".tum";
-    in.algorithm = tr.name;
-    in.options = sc.eval;
-    eval::FrameTable ft;
-    ft.names = {"yaw_deg", "pitch_deg", "roll_deg", "inliers", "mean_depth_m"};
-    ft.columns.resize(5);
-    for (std::size_t k = 0; k < camera_gt.size(); ++k) {
-      ft.t_ns.push_back(camera_gt[k].t_ns);
-      ft.columns[0].push_back(rad2deg(platform[k].yaw_rad));
-      ft.columns[1].push_back(rad2deg(platform[k].pitch_rad));
-      ft.columns[2].push_back(rad2deg(platform[k].roll_rad));
-      const vo::VoResult& r = src.results[k];
-      // Covariate f: inlier features (sparse, river paper Table 4), pixels with valid depth
-      // (dense).
-      const double f = src.name == "dense" ? r.valid_depth_pixels : r.inliers;
-      ft.columns[3].push_back(r.valid ? f : std::numeric_limits<double>::quiet_NaN());
-      ft.columns[4].push_back(r.valid ? r.mean_inlier_depth_m
-                                      : std::numeric_limits<double>::quiet_NaN());
-    }
-    in.frames = ft;
-    const eval::Evaluation e = eval::evaluate(in);
-    (*metrics)["algorithms"][tr.name] = eval::to_json(e, sc.eval);
-    report += eval::tables_markdown(e, sc.eval) + "\n";
-    const std::string csv = eval::sections_csv(e);
-    sections += sections.empty() ? csv : csv.substr(csv.find('\n') + 1);
-    if (tr.vo)
-      (*metrics)["timing"]["vo_ms_per_frame"][tr.name] =
-          tr.vo_ms / static_cast<double>(camera_gt.size());
-  }
+  report += evaluate_tracks(sc, tracks, mission, metrics, &sections);
   write_file_atomic(dir / "sections.csv", sections);
   report += compare_filters_with_raw_vo(tracks, metrics, &warnings);
 
-  // Report: plots (gnuplot) and the same report as HTML.
-  std::vector<report::NamedTrajectory> named;
-  for (const auto& tr : tracks) named.push_back({tr.name, tr.estimate});
-  report::PlotSet made = report::make_plots(dir, camera_gt, named, sections);
-  if (!made.warning.empty()) warnings.push_back(made.warning);
-  std::vector<report::PlotFile>& plots = made.files;
-  for (const auto& tr : tracks)
-    if (std::filesystem::exists(dir / "plots" / (tr.name + "_matches.png")))
-      plots.push_back({fmt::format("Stereo pair at frame {} with the {} matches: current left "
-                                   "(top) and right (bottom), inliers green, outliers red, flow "
-                                   "from the previous frame in orange (Fig. 3)",
-                                   sample_frame, tr.name),
-                       "plots/" + tr.name + "_matches.png"});
-  if (metrics->contains("external_vo")) {  // every external VO's fate, failures included
-    report +=
-        "## External VOs\n\n| name | status | exit | seconds | message |\n|---|---|---|---|---|\n";
-    for (const auto& [name, r] : (*metrics)["external_vo"].items())
-      report += fmt::format("| {} | {} | {} | {:.2f} | {} |\n", name,
-                            r["status"].get<std::string>(), r["exit"].get<std::string>(),
-                            r["seconds"].get<double>(), r["message"].get<std::string>());
-    report += "\nEach command's output is in external/NAME/log.txt.\n\n";
-  }
-  const std::string tables = report;
-  if (!plots.empty()) report += "## Plots\n\n";
-  for (const auto& p : plots) report += fmt::format("![{}]({})\n\n", p.title, p.file);
-  write_file_atomic(dir / "report.md", report);
-  write_file_atomic(dir / "report.html",
-                    report::report_html("driftlab run: " + sc.name, tables, plots));
+  write_report(sc, tracks, camera_gt, dir, sample_frame, sections, report, *metrics, &warnings);
   (*metrics)["timing"]["render_s"] = render_s;
   (*metrics)["timing"]["render_pairs_per_s"] =
       render_s > 0 ? static_cast<double>(camera_gt.size() - dropped) / render_s : 0.0;
