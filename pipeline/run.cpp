@@ -328,6 +328,29 @@ void write_report(const Scenario& sc, const std::vector<Track>& tracks, const Tr
                     report::report_html("driftlab run: " + sc.name, tables, plots));
 }
 
+// One frame of a track: a VO's result is kept; a smoother or filter starts at the first
+// delivered frame and then adds a pose (a filter's absolute pose; otherwise the increment,
+// river paper Eq. (3)).
+void advance_track(Track* track, std::size_t k, bool first, TimeNs t, const vo::VoResult& r) {
+  Track& tr = *track;
+  if (tr.vo) {
+    tr.results[k] = r;
+    tr.vo_ms += r.times.total_ms;
+  }
+  if (first) {
+    if (tr.smoother) tr.smoother->update(t, r);  // starts the clock
+    if (tr.filter) tr.filter->step(t, r);        // starts from the anchor
+    return;
+  }
+  if (tr.filter) {  // absolute poses, not increments
+    tr.estimate.push_back({t, tr.filter->step(t, r)});
+    return;
+  }
+  SE3 step = r.valid ? r.T_prev_curr : SE3();
+  if (tr.smoother) step = tr.smoother->update(t, r).T_prev_curr;
+  tr.estimate.push_back({t, tr.estimate.back().T_W_C * step});  // river paper Eq. (3)
+}
+
 // The constant-acceleration smoother with its backward pass over the delivered frames of VO
 // track `track` (index `source`), anchored where the VO's estimate starts.
 Track rts_smoothed(const Track& track, std::size_t source,
@@ -415,31 +438,15 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
     std::string row = fmt::format("{},{},{},{},{:.3f},{}", t, rad2deg(platform[k].yaw_rad),
                                   rad2deg(platform[k].pitch_rad), rad2deg(platform[k].roll_rad),
                                   render_ms, yaml::format_double(exposure_ms));
-    for (std::size_t i = 0; i < tracks.size(); ++i) {
-      Track& tr = tracks[i];
+    for (Track& tr : tracks) {
       const vo::VoResult r = tr.vo ? tr.vo->process(frame) : tracks[tr.source].results[k];
       if (k == sample_frame && tr.vo && r.valid) {
         if (const auto* sparse = dynamic_cast<const vo::SparseStereoOdometry*>(tr.vo.get()))
           cv::imwrite((dir / "plots" / (tr.name + "_matches.png")).string(),
                       draw_matches(frame, sparse->last_matches()));
       }
-      if (tr.vo) {
-        tr.results[k] = r;
-        tr.vo_ms += r.times.total_ms;
-        row += vo_csv_cells(r);
-      }
-      if (k == first) {
-        if (tr.smoother) tr.smoother->update(t, r);  // starts the clock
-        if (tr.filter) tr.filter->step(t, r);        // starts from the anchor
-        continue;
-      }
-      if (tr.filter) {  // absolute poses, not increments
-        tr.estimate.push_back({t, tr.filter->step(t, r)});
-        continue;
-      }
-      SE3 step = r.valid ? r.T_prev_curr : SE3();
-      if (tr.smoother) step = tr.smoother->update(t, r).T_prev_curr;
-      tr.estimate.push_back({t, tr.estimate.back().T_W_C * step});  // river paper Eq. (3)
+      if (tr.vo) row += vo_csv_cells(r);
+      advance_track(&tr, k, k == first, t, r);
     }
     frames_csv.write(row + "\n");
     external.add_frame(t, img, camera_gt[k]);
