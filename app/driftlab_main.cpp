@@ -27,6 +27,7 @@
 #include "pipeline/render_stage.hpp"
 #include "pipeline/run.hpp"
 #include "pipeline/scenario.hpp"
+#include "pipeline/scenario_checks.hpp"
 #include "report/paper_compare.hpp"
 
 #ifndef DRIFTLAB_VERSION
@@ -41,6 +42,8 @@ namespace fs = std::filesystem;
 int scenario_check(const std::string& file, const std::vector<std::string>& overrides, bool quiet) {
   const auto scenario = driftlab::pipeline::load_scenario(file, overrides);
   if (!quiet) std::cout << driftlab::pipeline::resolved_yaml(scenario);
+  for (const std::string& w : driftlab::pipeline::implausible_values(scenario))
+    std::cerr << "warning: " << w << "\n";
   std::cerr << fmt::format("{}: OK (scenario '{}', seed {})\n", file, scenario.name, scenario.seed);
   return 0;
 }

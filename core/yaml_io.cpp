@@ -29,6 +29,7 @@ Check Check::operator&(const Check& o) const {
   c.max_size = std::min(c.max_size, o.max_size);
   c.non_empty_string = c.non_empty_string || o.non_empty_string;
   if (o.choices) c.choices = o.choices;
+  if (!o.why.empty()) c.why = c.why.empty() ? o.why : c.why + "; " + o.why;
   return c;
 }
 
@@ -46,6 +47,7 @@ std::string Check::describe() const {
   } else if (has_hi) {
     parts.push_back(fmt::format("{} {}", hi_open ? "<" : "<=", format_double(hi)));
   }
+  if (!why.empty() && !parts.empty()) parts.back() += " (" + why + ")";
   const bool has_max = max_size != std::numeric_limits<std::size_t>::max();
   if (non_empty_string && min_size <= 1 && !has_max) {
     parts.push_back("non-empty");
@@ -231,8 +233,11 @@ void Reader::check_number(const YAML::Node& node, const std::string& key_path, d
   const bool low = check.lo_open ? !(v > check.lo) : !(v >= check.lo);
   const bool high = check.hi_open ? !(v < check.hi) : !(v <= check.hi);
   if (low || high) {
-    Check bounds{
-        .lo = check.lo, .hi = check.hi, .lo_open = check.lo_open, .hi_open = check.hi_open};
+    Check bounds{.lo = check.lo,
+                 .hi = check.hi,
+                 .lo_open = check.lo_open,
+                 .hi_open = check.hi_open,
+                 .why = check.why};
     fail(node, key_path, format_double(v), "a value " + bounds.describe());
   }
 }
@@ -406,8 +411,11 @@ void Validator::check_double(const std::string& key_path, double v, const Check&
   const bool low = check.lo_open ? !(v > check.lo) : !(v >= check.lo);
   const bool high = check.hi_open ? !(v < check.hi) : !(v <= check.hi);
   if (low || high) {
-    Check bounds{
-        .lo = check.lo, .hi = check.hi, .lo_open = check.lo_open, .hi_open = check.hi_open};
+    Check bounds{.lo = check.lo,
+                 .hi = check.hi,
+                 .lo_open = check.lo_open,
+                 .hi_open = check.hi_open,
+                 .why = check.why};
     errors_->add(fmt::format("{}: got {}, expected a value {}", key_path, format_double(v),
                              bounds.describe()));
   }

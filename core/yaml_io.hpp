@@ -56,6 +56,9 @@ struct Check {
   /// Strings (and the strings of a list) must be one of these names, asked for when the
   /// value is checked: a list that grows at run time (e.g. the VOs a program registers).
   std::function<std::vector<std::string>()> choices{};
+  /// Why the bounds are what they are (a plausible range's reason), shown after them in
+  /// messages and in the reference.
+  std::string why{};
 
   /// Combine two checks (both must hold).
   Check operator&(const Check& o) const;
@@ -72,6 +75,14 @@ inline Check greater_than(double v) { return {.lo = v, .lo_open = true}; }
 inline Check at_most(double v) { return {.hi = v}; }
 inline Check in_range(double lo, double hi) { return {.lo = lo, .hi = hi}; }
 inline Check unit_interval() { return in_range(0.0, 1.0); }
+/// An upper bound on what a user could mean, with the reason: combine with a lower bound,
+/// e.g. `yaml::positive() & yaml::up_to(2000, "wider than any surveyed river")`. Values past
+/// it are rejected before any work starts (a 1e308 m river would never finish building).
+inline Check up_to(double hi, std::string why) { return {.hi = hi, .why = std::move(why)}; }
+/// A closed range of plausible values with the reason.
+inline Check plausible(double lo, double hi, std::string why) {
+  return {.lo = lo, .hi = hi, .why = std::move(why)};
+}
 inline Check min_size(std::size_t n) { return {.min_size = n}; }
 inline Check size_between(std::size_t lo, std::size_t hi) {
   return {.min_size = lo, .max_size = hi};

@@ -22,6 +22,7 @@
 #include "pipeline/frame_source.hpp"
 #include "pipeline/progress.hpp"
 #include "pipeline/render_stage.hpp"
+#include "pipeline/scenario_checks.hpp"
 #include "pipeline/sensor_stage.hpp"
 #include "pipeline/vo_stage.hpp"
 #include "report/run_report.hpp"
@@ -406,7 +407,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   // Stages: VO and fusion. VO sees images and the rig only; the pipeline
   // anchors every estimate at the true first pose so that tracks overlay.
   std::vector<Track> tracks = make_tracks(sc, rig, sensor_data, camera_gt, rng);
-  std::vector<std::string> warnings;
+  std::vector<std::string> warnings = implausible_values(sc);
   const std::size_t n_vo = sc.pipeline.vo.size();
   std::size_t first = 0;  // the first frame the camera delivers
   while (first < stamps.size() && first < camera_gt.size() && stamps[first].dropped) ++first;

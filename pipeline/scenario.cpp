@@ -11,6 +11,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "pipeline/scenario_checks.hpp"
 
 namespace driftlab::pipeline {
 namespace {
@@ -139,6 +140,8 @@ void validate_scenario(const Scenario& s, const std::string& label) {
         "true frame times, expected at most eval.association_tolerance_s = {} s (raise it, "
         "below half the frame period, to evaluate a camera with this clock)",
         clock.offset_ms, clock.jitter_ms, stamp_error_s, s.eval.association_tolerance_s));
+  if (errors.empty())  // combinations only once every value is in range
+    for (const std::string& problem : impossible_combinations(s)) errors.add(problem);
   errors.throw_if_any(label + ": invalid scenario:");
 }
 

@@ -53,17 +53,18 @@ struct RiverReachOptions {
     });
     a("river_width_m", river_width_m,
       "Water width between the banks [m]; always 2 x bank_distance_m (set either)",
-      yaml::positive());
+      yaml::positive() & yaml::up_to(2000, "wider than the rivers a survey boat maps"));
     a("reach_length_m", reach_length_m,
       "Length of one reach tile [m]; tiles are laid end to end along the river, each with its "
       "own bridge, quay and buildings (vegetation differs from tile to tile)",
-      yaml::at_least(10));
-    a("bank_height_m", bank_height_m, "Bank top above the water [m]", yaml::non_negative());
+      yaml::at_least(10) & yaml::up_to(5000, "one tile; a longer river is tiles laid end to end"));
+    a("bank_height_m", bank_height_m, "Bank top above the water [m]",
+      yaml::non_negative() & yaml::up_to(100, "a gorge, not a river bank"));
     a("bank_slope_deg", bank_slope_deg, "Bank slope [deg]", yaml::in_range(1, 90));
     a("bank_distance_m", bank_distance_m,
       "Distance from the river centre line to the water's edge [m]; always river_width_m / 2 "
       "(set either)",
-      yaml::positive());
+      yaml::positive() & yaml::up_to(1000, "no river is wider than 2 km"));
     a.when_reading([&] {
       const bool width_set = !std::isnan(river_width_m), bank_set = !std::isnan(bank_distance_m);
       if (!width_set) river_width_m = width_before;
@@ -74,10 +75,11 @@ struct RiverReachOptions {
     a.require(std::abs(river_width_m - 2 * bank_distance_m) <= 1e-9 * river_width_m,
               "bank_distance_m", "river_width_m / 2 (the two describe the same river)");
     a("tree_line_distance_m", tree_line_distance_m,
-      "Distance of the tree line behind the water's edge [m]", yaml::non_negative());
+      "Distance of the tree line behind the water's edge [m]",
+      yaml::non_negative() & yaml::up_to(1000, "trees further away are not scenery a VO sees"));
     a("tree_height_m", tree_height_m,
       "Mean tree height [m]; each tree is drawn uniformly in [0.75, 1.25] x this",
-      yaml::positive());
+      yaml::positive() & yaml::up_to(120, "taller than the tallest trees"));
     a("vegetation_density", vegetation_density,
       "Trees and reeds per unit bank (0 = bare, 1 = a tree every 4 m in each of two rows)",
       yaml::unit_interval());
@@ -108,19 +110,20 @@ struct WaveBasinOptions {
   template <class A>
   void visit(A& a) {
     a("length_m", length_m, "Basin length from the wave generator (x = 0) northwards [m]",
-      yaml::positive());
-    a("width_m", width_m, "Basin width, walls at y = +-width_m / 2 [m]", yaml::positive());
+      yaml::positive() & yaml::up_to(2000, "longer than the longest towing tanks (under 1 km)"));
+    a("width_m", width_m, "Basin width, walls at y = +-width_m / 2 [m]",
+      yaml::positive() & yaml::up_to(500, "wider than the largest wave basins (about 100 m)"));
     a("wall_height_m", wall_height_m, "Wall height above the still water (the ceiling) [m]",
-      yaml::at_least(0.5));
+      yaml::at_least(0.5) & yaml::up_to(100, "no basin hall is higher"));
     a("beach_distance_m", beach_distance_m,
       "Distance from the wave generator to where the wave-absorbing beach meets the still "
       "water [m]",
-      yaml::positive());
+      yaml::positive() & yaml::up_to(2000, "no basin is longer"));
     a.require(beach_distance_m < length_m, "beach_distance_m", "less than length_m");
     a("water_depth_m", water_depth_m,
       "Depth of the basin floor below the still water [m] (keep equal to "
       "water.waves.water_depth_m)",
-      yaml::positive());
+      yaml::positive() & yaml::up_to(100, "deeper than the deepest basin pit"));
     a("beach_slope_deg", beach_slope_deg, "Slope of the beach [deg]", yaml::in_range(5, 60));
   }
 };

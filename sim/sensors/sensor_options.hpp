@@ -23,7 +23,8 @@ struct MountOptions {
   template <class A>
   void visit(A& a) {
     a("position_frd_m", position_frd_m,
-      "Lever arm from the centre of gravity, body FRD (x bow, y starboard, z down) [m]");
+      "Lever arm from the centre of gravity, body FRD (x bow, y starboard, z down) [m]",
+      yaml::plausible(-500, 500, "inside the largest vessel"));
     a("rpy_deg", rpy_deg,
       "Roll, pitch, yaw (ZYX) of the sensor relative to its nominal forward-looking mounting [deg]",
       yaml::in_range(-360, 360));
@@ -201,18 +202,21 @@ struct CameraOptions {
     });
     a("width_px", width_px, "Image width [px]", yaml::in_range(1, 16384));
     a("height_px", height_px, "Image height [px]", yaml::in_range(1, 16384));
-    a("fx_px", fx_px, "Focal length along x [px]", yaml::positive());
-    a("fy_px", fy_px, "Focal length along y [px]", yaml::positive());
+    a("fx_px", fx_px, "Focal length along x [px]",
+      yaml::positive() & yaml::up_to(1e5, "a telephoto beyond any survey camera"));
+    a("fy_px", fy_px, "Focal length along y [px]",
+      yaml::positive() & yaml::up_to(1e5, "a telephoto beyond any survey camera"));
     a("cx_px", cx_px, "Principal point x, OpenCV pixel-centre convention [px]");
     a("cy_px", cy_px, "Principal point y [px]");
     a.require(cx_px >= 0 && cx_px < width_px, "cx_px", "a principal point inside [0, width_px)");
     a.require(cy_px >= 0 && cy_px < height_px, "cy_px", "a principal point inside [0, height_px)");
-    a("baseline_m", baseline_m, "Stereo baseline B [m]", yaml::positive());
+    a("baseline_m", baseline_m, "Stereo baseline B [m]",
+      yaml::positive() & yaml::up_to(100, "a stereo rig wider than any vessel"));
     a("rate_hz", rate_hz, "Frame rate [Hz]", yaml::in_range(0.1, 1000) & yaml::positive());
     a("exposure_ms", exposure_ms,
       "Exposure time: scales the collected electrons (noise.reference_exposure_ms) and, in the "
       "renderer, motion blur [ms]",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(10000, "10 s per frame"));
     a.require(exposure_ms * 1e-3 * rate_hz <= 1.0, "exposure_ms",
               "an exposure no longer than the frame period");
     a("mount", mount, "Left camera mount on the body");
@@ -358,13 +362,13 @@ struct ImuOptions {
     a("mount", mount, "IMU mount on the body (sensor axes = body FRD at rpy 0)");
     a("gyro_noise_density_rad_s_sqrt_hz", gyro_noise_density_rad_s_sqrt_hz,
       "Gyroscope white-noise density (Kalibr gyroscope_noise_density) [rad/s/sqrt(Hz)]",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(1, "1000 x a consumer MEMS gyro"));
     a("gyro_random_walk_rad_s2_sqrt_hz", gyro_random_walk_rad_s2_sqrt_hz,
       "Gyroscope bias random walk (Kalibr gyroscope_random_walk) [rad/s^2/sqrt(Hz)]",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(1, "1000 x a consumer MEMS gyro"));
     a("gyro_turn_on_bias_rad_s", gyro_turn_on_bias_rad_s,
       "Standard deviation of the gyroscope bias drawn at switch-on, per axis [rad/s]",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(1, "57 deg/s: a broken gyro"));
     a("gyro_scale_factor_ppm", gyro_scale_factor_ppm,
       "Standard deviation of the gyroscope scale-factor error drawn at switch-on [ppm]",
       yaml::in_range(0, 1e5));
@@ -377,13 +381,13 @@ struct ImuOptions {
       yaml::non_negative());
     a("accel_noise_density_m_s2_sqrt_hz", accel_noise_density_m_s2_sqrt_hz,
       "Accelerometer white-noise density (Kalibr accelerometer_noise_density) [m/s^2/sqrt(Hz)]",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(10, "1000 x a consumer MEMS accelerometer"));
     a("accel_random_walk_m_s3_sqrt_hz", accel_random_walk_m_s3_sqrt_hz,
       "Accelerometer bias random walk (Kalibr accelerometer_random_walk) [m/s^3/sqrt(Hz)]",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(10, "1000 x a consumer MEMS accelerometer"));
     a("accel_turn_on_bias_m_s2", accel_turn_on_bias_m_s2,
       "Standard deviation of the accelerometer bias drawn at switch-on, per axis [m/s^2]",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(10, "1 g: a broken accelerometer"));
     a("accel_scale_factor_ppm", accel_scale_factor_ppm,
       "Standard deviation of the accelerometer scale-factor error drawn at switch-on [ppm]",
       yaml::in_range(0, 1e5));
@@ -474,7 +478,7 @@ struct GpsOptions {
     a("sigma_horizontal_m", sigma_horizontal_m,
       "Horizontal noise at HDOP 1 [m]: the user-equivalent range error; the position error has "
       "covariance sigma^2 (H^T H)^-1, i.e. horizontal RMS sigma * HDOP, vertical sigma * VDOP",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(1000, "1 km: no GPS"));
     a("datum_lat_lon_h", datum_lat_lon_h,
       "Local tangent-plane origin (the world NED origin): WGS84 latitude [deg], longitude "
       "[deg], ellipsoidal height [m]");
@@ -488,7 +492,8 @@ struct GpsOptions {
       "No fix with fewer visible satellites (a 3D fix needs 4: position and clock)",
       yaml::in_range(4, 64));
     a("antenna_frd_m", antenna_frd_m,
-      "Antenna phase centre from the centre of gravity, body FRD [m]");
+      "Antenna phase centre from the centre of gravity, body FRD [m]",
+      yaml::plausible(-500, 500, "inside the largest vessel"));
     a("constellation", constellation,
       "orbits: GPS-like circular orbits (6 planes at 55 deg inclination, 26 560 km, half a "
       "sidereal day) seen from datum_lat_lon_h, with the sky's real holes (none near the "
@@ -536,7 +541,7 @@ struct MagneticAnomalyOptions {
     a("field_ned_nt", field_ned_nt, "Field perturbation at the structure, world NED [nT]",
       yaml::in_range(-1e6, 1e6));
     a("decay_length_m", decay_length_m, "Distance at which the perturbation has halved [m]",
-      yaml::positive());
+      yaml::positive() & yaml::up_to(1e4, "10 km: no local anomaly"));
     a("decay_exponent", decay_exponent,
       "Far-field fall-off exponent: 2 for a line of dipoles (sheet piling), 3 for a point dipole",
       yaml::in_range(0.5, 6));
@@ -571,7 +576,7 @@ struct CompassOptions {
     a("sigma_deg", sigma_deg,
       "Heading noise standard deviation, added to the heading computed from the (distorted) "
       "field [deg]",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(180, "noise beyond half a turn"));
     a("mount", mount, "Magnetometer mount on the body (sensor axes = body FRD at rpy 0)");
     a("field_intensity_nt", field_intensity_nt,
       "Total intensity F of the Earth's field at the site (about 49000 in southern England) "
@@ -585,7 +590,7 @@ struct CompassOptions {
       yaml::in_range(-180, 180));
     a("field_noise_nt", field_noise_nt,
       "Standard deviation of the white noise on each field axis, per sample [nT]",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(1e5, "twice the Earth field"));
     a("hard_iron_nt", hard_iron_nt, "Hard-iron offset in the sensor frame [nT]",
       yaml::in_range(-1e6, 1e6));
     a("soft_iron", soft_iron,
@@ -601,7 +606,8 @@ struct CompassOptions {
       "Field perturbation of those scene anomalies at the structure, world NED [nT]",
       yaml::in_range(-1e6, 1e6));
     a("steel_decay_length_m", steel_decay_length_m,
-      "Distance at which the scene anomalies have halved [m]", yaml::positive());
+      "Distance at which the scene anomalies have halved [m]",
+      yaml::positive() & yaml::up_to(1e4, "10 km: no local anomaly"));
     a("steel_decay_exponent", steel_decay_exponent, "Far-field fall-off of the scene anomalies",
       yaml::in_range(0.5, 6));
     a("clock", clock, "Sample time stamps: offset, jitter, dropped samples");

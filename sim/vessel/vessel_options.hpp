@@ -27,10 +27,14 @@ struct HullOptions {
 
   template <class A>
   void visit(A& a) {
-    a("length_m", length_m, "Hull length [m]", yaml::positive());
-    a("beam_m", beam_m, "Hull beam [m]", yaml::positive());
-    a("depth_m", depth_m, "Hull depth, keel to deck [m]", yaml::positive());
-    a("kg_m", kg_m, "Height of the centre of gravity above the keel [m]", yaml::non_negative());
+    a("length_m", length_m, "Hull length [m]",
+      yaml::positive() & yaml::up_to(400, "longer than the largest ships"));
+    a("beam_m", beam_m, "Hull beam [m]",
+      yaml::positive() & yaml::up_to(70, "wider than the largest ships"));
+    a("depth_m", depth_m, "Hull depth, keel to deck [m]",
+      yaml::positive() & yaml::up_to(40, "deeper than the largest ships"));
+    a("kg_m", kg_m, "Height of the centre of gravity above the keel [m]",
+      yaml::non_negative() & yaml::up_to(40, "no hull is deeper"));
     a.require(kg_m < depth_m, "kg_m", "a centre of gravity below the deck (kg_m < depth_m)");
     a("panels_along", panels_along, "Pressure panels along the hull", yaml::in_range(2, 200));
     a("panels_across", panels_across, "Pressure panels across the hull", yaml::in_range(2, 200));
@@ -49,13 +53,13 @@ struct ThrusterOptions {
   void visit(A& a) {
     a("x_m", x_m, "Longitudinal position from the centre of gravity (bow positive) [m]");
     a("lateral_offset_m", lateral_offset_m, "Distance of each thruster from the centre line [m]",
-      yaml::positive());
+      yaml::positive() & yaml::up_to(35, "no ship is wider than 70 m"));
     a("max_thrust_n", max_thrust_n, "Largest forward thrust of one thruster (0 = none) [N]",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(1e7, "more than the largest ship propellers"));
     a("reverse_fraction", reverse_fraction, "Largest reverse thrust as a fraction of forward",
       yaml::unit_interval());
     a("time_constant_s", time_constant_s, "First-order lag of the thrust response [s]",
-      yaml::positive());
+      yaml::positive() & yaml::up_to(600, "a thruster that takes 10 minutes to respond"));
   }
 };
 
@@ -69,8 +73,11 @@ struct TowOptions {
   template <class A>
   void visit(A& a) {
     a("attach_x_m", attach_x_m, "Tow point on the hull, from the centre of gravity [m]");
-    a("rope_length_m", rope_length_m, "Unstretched rope length [m]", yaml::positive());
-    a("stiffness_n_m", stiffness_n_m, "Rope stiffness when taut [N/m]", yaml::positive());
+    a("rope_length_m", rope_length_m, "Unstretched rope length [m]",
+      yaml::positive() & yaml::up_to(10000, "a 10 km tow line"));
+    a("stiffness_n_m", stiffness_n_m, "Rope stiffness when taut [N/m]",
+      yaml::positive() &
+          yaml::up_to(1e10, "stiffer than a steel bar; the physics step cannot follow"));
     a("damping_n_s_m", damping_n_s_m, "Rope damping when taut [N s/m]", yaml::non_negative());
   }
 };
@@ -92,7 +99,8 @@ struct ControlOptions {
     a("heading_kd", heading_kd, "Heading PID derivative gain [N m s/rad]", yaml::non_negative());
     a("speed_kp", speed_kp, "Speed PI proportional gain [N s/m]", yaml::non_negative());
     a("speed_ki", speed_ki, "Speed PI integral gain [N/m]", yaml::non_negative());
-    a("lookahead_m", lookahead_m, "Line-of-sight lookahead distance [m]", yaml::positive());
+    a("lookahead_m", lookahead_m, "Line-of-sight lookahead distance [m]",
+      yaml::positive() & yaml::up_to(10000, "a 10 km lookahead"));
     a("turn_tolerance_deg", turn_tolerance_deg,
       "A turn in place ends when the heading is this close [deg]", yaml::positive());
   }
@@ -130,14 +138,16 @@ struct VesselOptions {
         *this = p;
       }
     });
-    a("start_ne_m", start_ne_m, "Initial position, north and east in the world NED frame [m]");
+    a("start_ne_m", start_ne_m, "Initial position, north and east in the world NED frame [m]",
+      yaml::plausible(-1e5, 1e5, "100 km from the world origin: float rendering loses precision"));
     a("start_heading_deg", start_heading_deg, "Initial heading (yaw), clockwise from north [deg]",
       yaml::in_range(-360, 360));
     a("physics_rate_hz", physics_rate_hz,
       "Fixed integration rate of the rigid-body physics (RK4) [Hz]", yaml::in_range(10, 10000));
-    a("mass_kg", mass_kg, "Mass [kg]", yaml::positive());
+    a("mass_kg", mass_kg, "Mass [kg]",
+      yaml::positive() & yaml::up_to(1e9, "heavier than the largest ships"));
     a("gyration_radii_m", gyration_radii_m, "Radii of gyration about body x, y, z [m]",
-      yaml::positive());
+      yaml::positive() & yaml::up_to(200, "no ship is larger"));
     a("added_mass", added_mass, "Diagonal added mass A11, A22, A33 [kg] and A44, A55, A66 [kg m^2]",
       yaml::non_negative());
     a("linear_damping", linear_damping,
@@ -197,7 +207,8 @@ struct YawWeaveOptions {
   void visit(A& a) {
     a("amplitude_deg", amplitude_deg, "Amplitude of a sinusoidal heading weave [deg]",
       yaml::in_range(0, 90));
-    a("period_s", period_s, "Period of the heading weave [s]", yaml::positive());
+    a("period_s", period_s, "Period of the heading weave [s]",
+      yaml::positive() & yaml::up_to(86400, "longer than any run"));
   }
 };
 
@@ -218,14 +229,15 @@ struct MissionOptions {
     a("speed_mps", speed_mps, "Commanded speed through the water [m/s]", yaml::in_range(0, 5));
     a("duration_s", duration_s,
       "Stop after this time; 0 runs until the mission pattern is complete [s]",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(86400, "a day of simulated time; longer than any survey"));
     a("crossings", crossings, "Number of river crossings (type: transects)",
       yaml::in_range(1, 1000));
     a("crossing_width_m", crossing_width_m, "Length of one crossing (type: transects) [m]",
-      yaml::positive());
+      yaml::positive() & yaml::up_to(2000, "no river is wider"));
     a("survey_length_m", survey_length_m, "Track length (type: survey, straight, tow) [m]",
-      yaml::positive());
-    a("waypoints_ne_m", waypoints_ne_m, "Waypoints, north and east [m] (type: waypoints)");
+      yaml::positive() & yaml::up_to(100000, "100 km in one run"));
+    a("waypoints_ne_m", waypoints_ne_m, "Waypoints, north and east [m] (type: waypoints)",
+      yaml::plausible(-1e5, 1e5, "100 km from the world origin: float rendering loses precision"));
     a("waypoints_file", waypoints_file,
       "CSV of waypoints 'north_m,east_m', relative to the scenario file; appended to "
       "waypoints_ne_m (type: waypoints)");

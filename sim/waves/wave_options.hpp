@@ -26,12 +26,14 @@ struct WaveComponentOptions {
 
   template <class A>
   void visit(A& a) {
-    a("amplitude_m", amplitude_m, "Wave amplitude zeta_a [m]", yaml::non_negative());
-    a("wavelength_m", wavelength_m, "Wavelength lambda [m]", yaml::positive());
+    a("amplitude_m", amplitude_m, "Wave amplitude zeta_a [m]",
+      yaml::non_negative() & yaml::up_to(20, "higher than the largest measured ocean waves"));
+    a("wavelength_m", wavelength_m, "Wavelength lambda [m]",
+      yaml::positive() & yaml::up_to(2000, "longer than any wind wave or swell"));
     a("period_s", period_s,
       "Wave period T [s]; 0: wavelength_m sets the wave. When > 0 the period sets it (wavelength "
       "from the finite-depth dispersion relation) and wavelength_m is not used",
-      yaml::non_negative());
+      yaml::non_negative() & yaml::up_to(60, "longer than any swell"));
     a("direction_deg", direction_deg, "Direction the wave travels towards, from north [deg]",
       yaml::in_range(-360, 360));
     a("phase_deg", phase_deg, "Phase at the origin at t = 0 [deg]", yaml::in_range(-360, 360));
@@ -55,19 +57,21 @@ struct WaveOptions {
   void visit(A& a) {
     a("model", model, "Wave field model");
     a("water_depth_m", water_depth_m, "Water depth for the finite-depth dispersion relation [m]",
-      yaml::positive());
+      yaml::positive() & yaml::up_to(11000, "deeper than the deepest ocean"));
     a("airy", airy, "The regular wave (model: airy)");
     a("components", components, "Sum of regular waves (model: components)");
     a.require(model != WaveModel::kComponents || !components.empty(), "components",
               "at least one component when model is 'components'");
     a("significant_height_m", significant_height_m, "JONSWAP significant wave height Hs [m]",
-      yaml::positive());
-    a("peak_period_s", peak_period_s, "JONSWAP peak period Tp [s]", yaml::positive());
+      yaml::positive() & yaml::up_to(20, "above the largest sea states measured (Hs about 19 m)"));
+    a("peak_period_s", peak_period_s, "JONSWAP peak period Tp [s]",
+      yaml::positive() & yaml::up_to(30, "longer than any measured sea"));
     a("peak_enhancement_gamma", peak_enhancement_gamma, "JONSWAP peak enhancement factor gamma",
-      yaml::at_least(1));
+      yaml::at_least(1) & yaml::up_to(20, "measured seas give 1 to 7"));
     a("mean_direction_deg", mean_direction_deg, "JONSWAP mean direction of travel [deg]",
       yaml::in_range(-360, 360));
-    a("spreading_s", spreading_s, "cos-2s directional spreading exponent s", yaml::positive());
+    a("spreading_s", spreading_s, "cos-2s directional spreading exponent s",
+      yaml::positive() & yaml::up_to(1000, "s = 1000 is already a single direction"));
     a("num_frequencies", num_frequencies, "JONSWAP frequency components", yaml::in_range(1, 4096));
     a("num_directions", num_directions, "JONSWAP direction components", yaml::in_range(1, 512));
     // Linear theory needs water under every trough: a trough that reaches the

@@ -96,7 +96,7 @@ TEST(Cli, SetOverridesAreValidatedLikeTheFile) {
   Result r = run_cli({"scenario", "check", "-q", file, "--set", "sensors.camera.baseline_m=-1"});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("--set sensors.camera.baseline_m=-1: sensors.camera.baseline_m: got -1, "
-                          "expected a value > 0"),
+                          "expected a value in (0, 100] (a stereo rig wider than any vessel)"),
             std::string::npos)
       << r.output;
   r = run_cli({"scenario", "check", "-q", file, "--set", "sensors.camera.nope=1"});

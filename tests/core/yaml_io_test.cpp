@@ -133,6 +133,36 @@ TEST(YamlReader, NonFiniteAndOutOfRangeAreErrors) {
   EXPECT_NE(error_of("count: 3000000000\n").find("expected an integer"), std::string::npos);
 }
 
+struct River {
+  double width_m = 20;
+  template <class A>
+  void visit(A& a) {
+    a("width_m", width_m, "Width [m]", positive() & up_to(2000, "no river is wider"));
+  }
+};
+
+TEST(YamlCheck, APlausibleRangeSaysWhyInMessagesAndTheReference) {
+  const Check c = positive() & up_to(2000, "no river is wider");
+  EXPECT_EQ(c.describe(), "in (0, 2000] (no river is wider)");
+  EXPECT_EQ(plausible(-5, 5, "a").describe(), "in [-5, 5] (a)");
+  EXPECT_EQ((plausible(0, 9, "a") & up_to(4, "b")).describe(), "in [0, 4] (a; b)");
+  EXPECT_EQ(positive().describe(), "> 0");  // no reason, no parentheses
+  River r;
+  try {
+    read_into(YAML::Load("width_m: 1e308"), {"r.yaml", true}, &r);
+    ADD_FAILURE() << "1e308 m accepted";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "width_m: got 1e+308, expected a value in (0, 2000] (no river is wider)"),
+              std::string::npos)
+        << e.what();
+  }
+  r.width_m = 2500;
+  EXPECT_NE(validate(r).find("expected a value in (0, 2000] (no river is wider)"),
+            std::string::npos);
+  EXPECT_EQ(schema_of(River{}).front().constraint, "in (0, 2000] (no river is wider)");
+}
+
 TEST(YamlReader, EnumsListChoices) {
   EXPECT_NE(error_of("color: blue\n").find("color: got 'blue', expected one of: red, green"),
             std::string::npos);

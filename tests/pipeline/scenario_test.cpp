@@ -1,5 +1,6 @@
 #include "pipeline/scenario.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <set>
 
 #include "core/error.hpp"
+#include "pipeline/scenario_checks.hpp"
 
 namespace driftlab::pipeline {
 namespace {
@@ -161,6 +163,65 @@ TEST(Scenario, CrossSectionRules) {
             std::string::npos);
   EXPECT_NE(error_of("sensors: {camera: {rate_hz: 100, exposure_ms: 20}}\n")
                 .find("an exposure no longer than the frame period"),
+            std::string::npos);
+}
+
+// Miche's limit H / lambda <= 0.142 tanh(k d), computed here on its own: in 100 m of water a
+// 10 m wave is deep-water (tanh(k d) = 1 to 1e-27), so 1.40 m stands and 1.45 m breaks; in
+// 0.5 m of water tanh(k d) = tanh(0.1 pi) = 0.3042 lowers the limit to a 0.432 m wave. Such a
+// wave still runs (linear theory computes it): a warning, not an error.
+TEST(Scenario, WavesSteeperThanBreakingAreFlaggedWithTheMicheLimit) {
+  const auto warnings = [](double depth, double height, double length) {
+    const std::string text = fmt::format(
+        "water: {{waves: {{model: airy, water_depth_m: {}, airy: {{amplitude_m: {}, "
+        "wavelength_m: {}}}}}}}\n",
+        depth, height / 2, length);
+    const auto w = implausible_values(parse_scenario(text, "s.yaml", fs::temp_directory_path()));
+    return w.empty() ? std::string() : w.front();
+  };
+  EXPECT_EQ(warnings(100, 1.40, 10), "");
+  EXPECT_NE(warnings(100, 1.45, 10).find("steeper than the 0.142 at which waves break in 100 m"),
+            std::string::npos);
+  const double shallow_limit_m = 0.142 * std::tanh(2 * std::numbers::pi / 10 * 0.5) * 10;
+  EXPECT_NEAR(shallow_limit_m, 0.432, 5e-4);
+  EXPECT_EQ(warnings(0.5, shallow_limit_m * 0.99, 10), "");
+  EXPECT_NE(warnings(0.5, shallow_limit_m * 1.01, 10).find("(Miche)"), std::string::npos);
+  // The basin paper's experiment 4 (Table 1: 11 mm on a 59 mm wavelength) is such a wave.
+  EXPECT_EQ(implausible_values(load_scenario(kSource / "scenarios/basin_exp4.yaml")).size(), 1u);
+  EXPECT_TRUE(implausible_values(load_scenario(kSource / "scenarios/basin_exp2.yaml")).empty());
+}
+
+// A box hull floats at draft m / (rho L B): 55 kg in 1.95 x 0.73 m draws 38.6 mm, so with
+// the centre of gravity 0.15 m above the keel a camera mounted 0.11 m below it is 1.4 mm
+// above the water and one 0.112 m below it is 0.6 mm under.
+TEST(Scenario, TheCameraMustBeAboveTheWaterLineOfAFloatingHull) {
+  const auto mount = [](double z) {
+    return fmt::format("sensors: {{camera: {{mount: {{position_frd_m: [0.5, 0, {}]}}}}}}\n", z);
+  };
+  const Scenario defaults;
+  ASSERT_EQ(defaults.vessel.mass_kg, 55.0);
+  ASSERT_EQ(defaults.vessel.hull.kg_m, 0.15);
+  EXPECT_EQ(error_of(mount(0.11)), "");
+  EXPECT_NE(error_of(mount(0.112)).find("the camera sits 0.000637 m below the still water"),
+            std::string::npos)
+      << error_of(mount(0.112));
+  EXPECT_NE(error_of("vessel: {mass_kg: 499}\n").find("(it sinks)"), std::string::npos);
+  EXPECT_EQ(error_of("vessel: {mass_kg: 498}\n").find("(it sinks)"), std::string::npos);
+}
+
+TEST(Scenario, MissionsMustStartAndStayOnTheWater) {
+  EXPECT_EQ(error_of("vessel: {start_ne_m: [0, 9.9]}\n"), "");
+  EXPECT_NE(error_of("vessel: {start_ne_m: [0, 10]}\n").find("expected a point on the river"),
+            std::string::npos);
+  EXPECT_EQ(error_of("mission: {type: transects, crossing_width_m: 19.9}\n"), "");
+  EXPECT_NE(error_of("mission: {type: transects, crossing_width_m: 20}\n")
+                .find("crossings shorter than the river is wide"),
+            std::string::npos);
+  const std::string basin =
+      "scene: {type: wave_basin}\nvessel: {preset: basin_model, start_ne_m: [0.2, 0]}\n";
+  EXPECT_EQ(error_of(basin + "mission: {type: tow, survey_length_m: 2.7}\n"), "");
+  EXPECT_NE(error_of(basin + "mission: {type: tow, survey_length_m: 2.8}\n")
+                .find("the track ends at (3, 0)"),
             std::string::npos);
 }
 

@@ -103,7 +103,7 @@ TEST(SensorOptions, ImuPresetSetsTheNoiseFieldsAndLaterKeysOverride) {
 TEST(SensorOptions, BadValuesNameFileLineKeyAndExpectation) {
   const std::string neg = read_error("imu:\n  gyro_noise_density_rad_s_sqrt_hz: -1e-4\n");
   EXPECT_NE(neg.find("sensors.yaml:2:37: imu.gyro_noise_density_rad_s_sqrt_hz: got -1e-04, "
-                     "expected a value >= 0"),
+                     "expected a value in [0, 1] (1000 x a consumer MEMS gyro)"),
             std::string::npos)
       << neg;
   const std::string rate = read_error("imu: {rate_hz: 0}\n");
@@ -133,7 +133,8 @@ TEST(SensorOptions, SimulatorsRejectBadOptionsBuiltInCode) {
   imu.mount.position_frd_m[0] = std::nan("");
   const std::string e = user_error_of([&] { ImuSimulator s(imu, RngStreams(1)); });
   EXPECT_NE(e.find("sensors.imu: invalid options:"), std::string::npos) << e;
-  EXPECT_NE(e.find("sensors.imu.gyro_noise_density_rad_s_sqrt_hz: got -1, expected a value >= 0"),
+  EXPECT_NE(e.find("sensors.imu.gyro_noise_density_rad_s_sqrt_hz: got -1, expected a value in [0, "
+                   "1] (1000 x a consumer MEMS gyro)"),
             std::string::npos)
       << e;
   EXPECT_NE(e.find("sensors.imu.rate_hz: got 0, expected a value in [1, 10000]"), std::string::npos)
@@ -145,7 +146,8 @@ TEST(SensorOptions, SimulatorsRejectBadOptionsBuiltInCode) {
   compass.anomalies.push_back({});
   compass.anomalies[0].decay_length_m = 0;
   const std::string c = user_error_of([&] { CompassSimulator s(compass, RngStreams(1)); });
-  EXPECT_NE(c.find("sensors.compass.anomalies[0].decay_length_m: got 0, expected a value > 0"),
+  EXPECT_NE(c.find("sensors.compass.anomalies[0].decay_length_m: got 0, expected a value in (0, "
+                   "10000] (10 km: no local anomaly)"),
             std::string::npos)
       << c;
 }

@@ -600,21 +600,27 @@ TEST(Jonswap, SameSeedSameBytesOtherSeedOtherSea) {
 
 TEST(WaveOptionsErrors, ValidateNamesZeroWavelengthBadDepthAndNaN) {
   WaveOptions o = airy(0.005, 0.0, 0.0, 0.6);
-  EXPECT_NE(yaml::validate(o).find("airy.wavelength_m: got 0, expected a value > 0"),
+  EXPECT_NE(yaml::validate(o).find("airy.wavelength_m: got 0, expected a value in (0, 2000] "
+                                   "(longer than any wind wave or swell)"),
             std::string::npos)
       << yaml::validate(o);
   o = airy(0.005, 0.21, 0.0, 0.0);
-  EXPECT_NE(yaml::validate(o).find("water_depth_m: got 0, expected a value > 0"),
-            std::string::npos);
+  EXPECT_NE(
+      yaml::validate(o).find(
+          "water_depth_m: got 0, expected a value in (0, 11000] (deeper than the deepest ocean)"),
+      std::string::npos);
   o = airy(0.005, 0.21, 0.0, -1.0);
-  EXPECT_NE(yaml::validate(o).find("water_depth_m: got -1, expected a value > 0"),
-            std::string::npos);
+  EXPECT_NE(
+      yaml::validate(o).find(
+          "water_depth_m: got -1, expected a value in (0, 11000] (deeper than the deepest ocean)"),
+      std::string::npos);
   o = airy(std::numeric_limits<double>::quiet_NaN(), 0.21, 0.0, 0.6);
   EXPECT_NE(yaml::validate(o).find("airy.amplitude_m: got nan, expected a finite number"),
             std::string::npos);
   o = airy(0.005, 0.21, 0.0, 0.6);
   o.airy.period_s = -2.0;
-  EXPECT_NE(yaml::validate(o).find("airy.period_s: got -2, expected a value >= 0"),
+  EXPECT_NE(yaml::validate(o).find(
+                "airy.period_s: got -2, expected a value in [0, 60] (longer than any swell)"),
             std::string::npos);
   EXPECT_EQ(yaml::validate(airy(0.005, 0.21, 0.0, 0.6)), "");
   EXPECT_EQ(yaml::validate(jonswap()), "");
@@ -632,7 +638,8 @@ TEST(WaveOptionsErrors, YamlWithZeroWavelengthOrNaNFailsWithFileAndLine) {
     return std::string();
   };
   EXPECT_NE(error_of("model: airy\nairy:\n  wavelength_m: 0\n")
-                .find("w.yaml:3:17: airy.wavelength_m: got 0, expected a value > 0"),
+                .find("w.yaml:3:17: airy.wavelength_m: got 0, expected a value in (0, 2000] "
+                      "(longer than any wind wave or swell)"),
             std::string::npos)
       << error_of("model: airy\nairy:\n  wavelength_m: 0\n");
   EXPECT_NE(error_of("water_depth_m: .nan\n").find("water_depth_m: got '.nan', expected a finite"),
