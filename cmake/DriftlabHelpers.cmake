@@ -43,9 +43,10 @@ function(driftlab_module)
 endfunction()
 
 # A GoogleTest executable registered with ctest; the test name is the file stem.
-#   driftlab_test(core/se3_test.cpp LIBS driftlab::core)
+#   driftlab_test(core/se3_test.cpp LIBS driftlab::core [LABELS slow])
+# Label `slow`: left out of the sanitizer run (scripts/test --sanitize, in CI).
 function(driftlab_test source)
-  cmake_parse_arguments(T "" "" "LIBS" ${ARGN})
+  cmake_parse_arguments(T "" "" "LIBS;LABELS" ${ARGN})
   get_filename_component(stem ${source} NAME_WE)
   get_filename_component(dir ${source} DIRECTORY)
   string(REPLACE "/" "_" prefix "${dir}")
@@ -57,5 +58,13 @@ function(driftlab_test source)
     DRIFTLAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     DRIFTLAB_BINARY_DIR="${PROJECT_BINARY_DIR}")
   set_target_properties(${target} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
-  gtest_discover_tests(${target} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR} DISCOVERY_TIMEOUT 60)
+  set(props)
+  if(T_LABELS)
+    list(APPEND props LABELS ${T_LABELS})
+  endif()
+  if(DRIFTLAB_SANITIZER_ENV)
+    list(APPEND props ENVIRONMENT ${DRIFTLAB_SANITIZER_ENV})
+  endif()
+  gtest_discover_tests(${target} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR} DISCOVERY_TIMEOUT 60
+                       PROPERTIES ${props})
 endfunction()

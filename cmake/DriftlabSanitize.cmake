@@ -9,4 +9,8 @@ if(DRIFTLAB_SANITIZE)
   add_compile_options(-fsanitize=${san} -fno-omit-frame-pointer -fno-sanitize-recover=all)
   add_link_options(-fsanitize=${san})
   message(STATUS "driftlab: sanitizers ${san}")
+  # Every test and fuzz replay (and the programs they start): OSMesa's process-lifetime
+  # allocations are not leaks (tests/lsan.supp).
+  set(DRIFTLAB_SANITIZER_ENV
+      "LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/lsan.supp:print_suppressions=0")
 endif()
