@@ -24,6 +24,7 @@
 #include "pipeline/render_stage.hpp"
 #include "pipeline/scenario_checks.hpp"
 #include "pipeline/sensor_stage.hpp"
+#include "pipeline/tracking.hpp"
 #include "pipeline/vo_stage.hpp"
 #include "report/run_report.hpp"
 #include "scenes/build_scene.hpp"
@@ -176,6 +177,24 @@ cv::Mat draw_matches(const vo::StereoFrame& frame, std::span<const vo::SparseMat
   return out;
 }
 
+// Where each VO lost track: metrics (algorithms.NAME.tracking), a warning for a stretch of a
+// second or more, and the report's table.
+std::string report_tracking(const std::vector<Track>& tracks, const Trajectory& camera_gt,
+                            nlohmann::json* metrics, std::vector<std::string>* warnings) {
+  std::vector<std::string> names;
+  std::vector<TrackingSummary> summaries;
+  for (const Track& tr : tracks) {
+    if (!tr.vo) continue;
+    const TrackingSummary s = summarize_tracking(tr.results, camera_gt);
+    (*metrics)["algorithms"][tr.name]["tracking"] = s.to_json();
+    const std::string w = tracking_warning(tr.name, s);
+    if (!w.empty()) warnings->push_back(w);
+    names.push_back(tr.name);
+    summaries.push_back(s);
+  }
+  return names.empty() ? "" : tracking_table_markdown(names, summaries);
+}
+
 // Each filter's estimate against its raw VO's, by APE translation RMSE (the same evaluation,
 // the same frames): `vs_raw_vo` in the filter's metrics, a report table, and a warning for each
 // filter that is worse than the VO it filters, so that a filter that does not help says so.
@@ -266,8 +285,10 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
     in.algorithm = tr.name;
     in.options = sc.eval;
     eval::FrameTable ft;
-    ft.names = {"yaw_deg", "pitch_deg", "roll_deg", "inliers", "mean_depth_m"};
-    ft.columns.resize(5);
+    // `lost`: 1 where the VO gave no motion, so each section's mean is its share of such
+    // frames (the sections a lost stretch touched).
+    ft.names = {"yaw_deg", "pitch_deg", "roll_deg", "inliers", "mean_depth_m", "lost"};
+    ft.columns.resize(6);
     for (std::size_t k = 0; k < camera_gt.size(); ++k) {
       ft.t_ns.push_back(camera_gt[k].t_ns);
       ft.columns[0].push_back(rad2deg(platform[k].yaw_rad));
@@ -280,6 +301,7 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
       ft.columns[3].push_back(r.valid ? f : std::numeric_limits<double>::quiet_NaN());
       ft.columns[4].push_back(r.valid ? r.mean_inlier_depth_m
                                       : std::numeric_limits<double>::quiet_NaN());
+      ft.columns[5].push_back(lost_track(r) ? 1.0 : 0.0);
     }
     in.frames = ft;
     const eval::Evaluation e = eval::evaluate(in);
@@ -486,6 +508,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   std::string sections;
   report += evaluate_tracks(sc, tracks, mission, metrics, &sections);
   write_file_atomic(dir / "sections.csv", sections);
+  report += report_tracking(tracks, camera_gt, metrics, &warnings);
   report += compare_filters_with_raw_vo(tracks, metrics, &warnings);
 
   write_report(sc, tracks, camera_gt, dir, sample_frame, sections, report, *metrics, &warnings);
