@@ -303,6 +303,7 @@ YAML::Node load_file(const std::string& path) {
 }
 
 YAML::Node load_string(const std::string& text, const std::string& label) {
+  require_utf8(text, label);
   try {
     YAML::Node node = YAML::Load(text);
     if (!node || node.IsNull())
@@ -331,6 +332,7 @@ YAML::Node override_document(const std::string& assignment) {
     if (dot == std::string::npos) break;
     start = dot + 1;
   }
+  require_utf8(assignment, "--set " + key_path);
   YAML::Node value;
   try {
     value = value_text.empty() ? YAML::Node(std::string()) : YAML::Load(value_text);

@@ -3,6 +3,9 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+#include <limits>
+
 #include <opencv2/calib3d.hpp>
 
 #include "core/atomic_file.hpp"
@@ -143,43 +146,46 @@ struct CameraYaml {
   SE3 T_B_C;
 };
 
+// A list of `count` finite numbers (any count when 0) under `key` of the mapping `root`.
 std::vector<double> yaml_numbers(const YAML::Node& root, const char* key, std::size_t count,
                                  const fs::path& path) {
-  const YAML::Node node = root[key];
+  const YAML::Node node = root.IsMap() ? root[key] : YAML::Node();
   if (!node || !node.IsSequence() || (count && node.size() != count))
     throw UserError(fmt::format("{}: {}: expected a list of {} numbers", path.string(), key,
                                 count ? std::to_string(count) : "some"));
   std::vector<double> out;
   for (const auto& v : node) {
-    try {
-      out.push_back(v.as<double>());
-    } catch (const YAML::Exception&) {
-      throw UserError(fmt::format("{}:{}: {}: got '{}', expected a number", path.string(),
-                                  v.Mark().line + 1, key, v.Scalar()));
-    }
+    double x = std::numeric_limits<double>::quiet_NaN();
+    if (v.IsScalar()) yaml::parse_double(v.Scalar(), &x);
+    if (!std::isfinite(x))
+      throw UserError(fmt::format("{}:{}: {}: got '{}', expected a finite number", path.string(),
+                                  v.Mark().line + 1, key, v.IsScalar() ? v.Scalar() : "a list"));
+    out.push_back(x);
   }
   return out;
 }
 
-CameraYaml read_camera_yaml(const fs::path& path) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(read_text_file(path, "EuRoC sensor.yaml"));
-  } catch (const YAML::Exception& e) {
-    throw UserError(fmt::format("{}:{}: {}", path.string(), e.mark.line + 1, e.msg));
-  }
+// Kalibr's camera keys: intrinsics (fu, fv, cu, cv), resolution, distortion, T_BS.
+CameraYaml camera_from_yaml(const YAML::Node& root, const fs::path& path) {
+  if (!root.IsMap())
+    throw UserError(path.string() + ": expected a mapping of keys (intrinsics, resolution, T_BS)");
   CameraYaml c;
   const auto k = yaml_numbers(root, "intrinsics", 4, path);
   const auto res = yaml_numbers(root, "resolution", 2, path);
-  c.camera.fx = k[0];
-  c.camera.fy = k[1];
-  c.camera.cx = k[2];
-  c.camera.cy = k[3];
-  c.camera.width = static_cast<int>(res[0]);
-  c.camera.height = static_cast<int>(res[1]);
+  if (!(k[0] > 0 && k[1] > 0))
+    throw UserError(fmt::format("{}: intrinsics: got fu {} and fv {}, expected both > 0",
+                                path.string(), k[0], k[1]));
+  for (double r : res)
+    if (!(r >= 1 && r <= 16384 && r == std::floor(r)))
+      throw UserError(
+          fmt::format("{}: resolution: got {} x {}, expected whole numbers of pixels in [1, 16384]",
+                      path.string(), res[0], res[1]));
+  c.camera = {k[0], k[1], k[2], k[3], static_cast<int>(res[0]), static_cast<int>(res[1])};
   if (root["distortion_coefficients"])
     c.distortion = yaml_numbers(root, "distortion_coefficients", 0, path);
-  if (root["distortion_model"]) c.distortion_model = root["distortion_model"].as<std::string>();
+  if (root["distortion_model"])
+    c.distortion_model =
+        root["distortion_model"].IsScalar() ? root["distortion_model"].Scalar() : "(not a name)";
   const bool radtan = c.distortion_model.empty() || c.distortion_model == "radial-tangential" ||
                       c.distortion_model == "radtan";
   if (!radtan || (c.distortion.size() != 0 && c.distortion.size() != 4 && c.distortion.size() != 5))
@@ -191,10 +197,19 @@ CameraYaml read_camera_yaml(const fs::path& path) {
   Mat3 R;
   R << t[0], t[1], t[2], t[4], t[5], t[6], t[8], t[9], t[10];
   const Eigen::JacobiSVD<Mat3> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  if ((R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() > 1e-3)
+  if ((R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() > 1e-3 || R.determinant() < 0)
     throw UserError(path.string() + ": T_BS: the rotation part is not a rotation");
   c.T_B_C = SE3(Quat(Mat3(svd.matrixU() * svd.matrixV().transpose())), Vec3(t[3], t[7], t[11]));
   return c;
+}
+
+CameraYaml read_camera_yaml(const fs::path& path) {
+  const std::string text = read_text_file(path, "EuRoC sensor.yaml");
+  try {
+    return camera_from_yaml(YAML::Load(text), path);
+  } catch (const YAML::Exception& e) {
+    throw UserError(fmt::format("{}:{}: {}", path.string(), e.mark.line + 1, e.msg));
+  }
 }
 
 std::vector<std::pair<TimeNs, std::string>> read_camera_index(const fs::path& path) {
@@ -243,6 +258,10 @@ struct RectifiedPair {
 
 RectifiedPair rectify_pair(const CameraYaml& c0, const CameraYaml& c1, const fs::path& cam1_yaml) {
   RectifiedPair out;
+  if (!((c0.T_B_C.inverse() * c1.T_B_C).translation().norm() > 0))
+    throw UserError(
+        fmt::format("{}: T_BS: cam1 sits where cam0 does, expected a stereo pair with a baseline",
+                    cam1_yaml.string()));
   if (already_rectified(c0, c1)) {
     out.rig.camera = c0.camera;
     out.rig.baseline_m = (c0.T_B_C.inverse() * c1.T_B_C).translation().x();
@@ -301,7 +320,13 @@ StereoDataset read_euroc(const fs::path& root) {
   d.root = root;
   const CameraYaml c0 = read_camera_yaml(mav / "cam0" / "sensor.yaml");
   const CameraYaml c1 = read_camera_yaml(mav / "cam1" / "sensor.yaml");
-  const RectifiedPair pair = rectify_pair(c0, c1, mav / "cam1" / "sensor.yaml");
+  RectifiedPair pair;
+  try {
+    pair = rectify_pair(c0, c1, mav / "cam1" / "sensor.yaml");
+  } catch (const cv::Exception& e) {  // a calibration OpenCV cannot rectify
+    throw UserError(fmt::format("{}: the pair cannot be rectified ({}), expected a stereo pair",
+                                (mav / "cam1" / "sensor.yaml").string(), e.err));
+  }
   d.rig = pair.rig;
   d.rectification = pair.rectification;
   d.T_S_C = c0.T_B_C * pair.T_C0_Crect;

@@ -193,7 +193,7 @@ fs::path find_results_metrics(const fs::path& results) {
 nlohmann::json read_results_metrics(const fs::path& file) {
   try {
     return nlohmann::json::parse(read_text_file(file, "metrics.json"));
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // syntax, and numbers past double's range
     throw UserError(
         fmt::format("{}: not valid JSON ({}), expected metrics.json", file.string(), e.what()));
   }

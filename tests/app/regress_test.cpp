@@ -187,6 +187,25 @@ TEST_F(Regress, BadBaselineNamesFileLineFieldAndValue) {
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
+// What the fuzzer found (fuzz/regressions/gate): a number past double's range in
+// metrics.json, and a baseline that is not UTF-8, each a clear error, not a crash.
+TEST_F(Regress, ANumberPastDoubleOrTextThatIsNotUtf8IsABadInputNotACrash) {
+  write_baseline();
+  std::ofstream(dir_ / "run/metrics.json") << R"({"algorithms": {"sparse": {"x": 1e999}}})";
+  Result r = gate();
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.err.find("metrics.json: not valid JSON ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("number overflow"), std::string::npos) << r.err;
+  write_results(0.010, 0.50, 7.0);
+  std::ofstream(baseline(), std::ios::binary)
+      << "{\"description\": \"gate \xE9\", \"metrics\": []}";
+  r = gate();
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.err.find(baseline().string() + ":1:23: got byte 0xE9, expected UTF-8 text"),
+            std::string::npos)
+      << r.err;
+}
+
 TEST_F(Regress, ReadsAMergedSweepAndExplainsAnUnmergedOne) {
   const fs::path sweep = dir_ / "sweep";
   fs::create_directories(sweep);

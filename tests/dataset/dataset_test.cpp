@@ -244,6 +244,30 @@ TEST(DatasetReaders, NameTheFileLineAndExpectation) {
                    "radial-tangential"),
             std::string::npos)
       << e;
+  // What the fuzzer found (fuzz/regressions/dataset): each a UserError naming the file.
+  std::ofstream(cam1) << "just a scalar\n";
+  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  EXPECT_NE(e.find(cam1.string() + ": expected a mapping of keys (intrinsics, resolution, T_BS)"),
+            std::string::npos)
+      << e;
+  yaml = good_yaml;
+  const std::size_t res = yaml.find("resolution: [");
+  yaml.replace(res, yaml.find(']', res) - res, "resolution: [1e20, 60");
+  std::ofstream(cam1) << yaml;
+  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  EXPECT_NE(e.find("resolution: got 1e+20 x "), std::string::npos) << e;
+  EXPECT_NE(e.find("expected whole numbers of pixels in [1, 16384]"), std::string::npos) << e;
+  yaml = good_yaml;
+  const std::size_t fu = yaml.find("intrinsics: [");
+  yaml.replace(fu, yaml.find(',', fu) - fu, "intrinsics: [.nan");
+  std::ofstream(cam1) << yaml;
+  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  EXPECT_NE(e.find("intrinsics: got '.nan', expected a finite number"), std::string::npos) << e;
+  std::ofstream(cam1) << slurp(eu / "mav0" / "cam0" / "sensor.yaml");  // cam1 where cam0 is
+  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  EXPECT_NE(e.find("T_BS: cam1 sits where cam0 does, expected a stereo pair with a baseline"),
+            std::string::npos)
+      << e;
   std::ofstream(cam1) << good_yaml;
   std::ofstream(eu / "mav0" / "cam0" / "data.csv") << "#timestamp [ns],filename\n12x,a.png\n";
   e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
