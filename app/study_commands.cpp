@@ -73,6 +73,11 @@ StudyCommands::StudyCommands(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   run_->add_flag("--force", force_, "Run finished jobs again too");
+  run_->add_option("--job-timeout", job_timeout_s_,
+                   "Stop a job still running after this many seconds and record it as "
+                   "timed out (0: no limit)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
 
   status_ = sweep_->add_subcommand(
       "status", "List done, failed and missing jobs and how to finish them (locally or Slurm)");
@@ -131,6 +136,13 @@ void StudyCommands::add_run_options(CLI::App* run_cmd, CLI::Option* scenario, CL
   run_cmd->add_option("--parallel", run_parallel_, "Jobs at once with --shard")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  auto* timeout = run_cmd
+                      ->add_option("--job-timeout", job_timeout_s_,
+                                   "With --shard: stop a job still running after this many "
+                                   "seconds and record it as timed out (0: no limit)")
+                      ->capture_default_str()
+                      ->check(CLI::NonNegativeNumber);
+  timeout->needs(shard);
   job->needs(manifest);
   shard->needs(manifest);
   job->excludes(shard);
@@ -176,6 +188,7 @@ int StudyCommands::run_local() {
   o.executable = self_executable();
   o.parallel = parallel_;
   o.force = force_;
+  o.job_timeout_s = job_timeout_s_;
   o.on_progress = progress_printer();
   const pl::SweepRunSummary s = pl::run_sweep_jobs(m, o);
   std::cout << "sweep run: " << s.brief() << "\n";
@@ -277,6 +290,7 @@ int StudyCommands::run_manifest() {
   o.force = force;
   o.shard = pl::parse_shard(shard_);
   o.local = false;  // other machines may be running jobs of this sweep
+  o.job_timeout_s = job_timeout_s_;
   o.on_progress = progress_printer();
   const pl::SweepRunSummary s = pl::run_sweep_jobs(m, o);
   std::cout << fmt::format("shard {}: {}\n", shard_, s.brief());

@@ -53,6 +53,7 @@ class StudyCommands {
   std::size_t cpus_per_task_ = 1, max_parallel_ = 0, shards_ = 0;
   std::string manifest_, job_, shard_;
   std::size_t run_parallel_ = 1;
+  double job_timeout_s_ = 0;  // sweep run --job-timeout, run --shard --job-timeout
   const bool* run_force_ = nullptr;
 };
 

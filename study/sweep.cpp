@@ -1026,8 +1026,49 @@ std::string SweepStatus::brief() const {
                      stale, missing);
 }
 
+namespace {
+
+// The pids in a temporary's name: every number after a ".tmp." or ".old.".
+std::vector<pid_t> temporary_pids(const std::string& name) {
+  std::vector<pid_t> pids;
+  for (std::size_t pos = 0; (pos = name.find('.', pos)) != std::string::npos; ++pos) {
+    if (name.compare(pos, 5, ".tmp.") != 0 && name.compare(pos, 5, ".old.") != 0) continue;
+    std::size_t end = pos + 5;
+    while (end < name.size() && std::isdigit(static_cast<unsigned char>(name[end]))) ++end;
+    std::int64_t pid = 0;
+    if (end > pos + 5 && yaml::parse_int64(name.substr(pos + 5, end - pos - 5), &pid))
+      pids.push_back(static_cast<pid_t>(pid));
+  }
+  return pids;
+}
+
+bool any_alive(const std::vector<pid_t>& pids) {
+  return std::any_of(pids.begin(), pids.end(), [](pid_t p) { return process_alive(p); });
+}
+
+// A missing job with a temporary under runs/ was interrupted, or is running now.
+std::string interrupted_detail(const std::string& id, const std::vector<fs::path>& leftovers) {
+  for (const auto& p : leftovers) {
+    const std::string name = p.filename().string();
+    if (name.rfind(id + ".", 0) != 0) continue;
+    const auto pids = temporary_pids(name);
+    const std::string pid = pids.empty() ? "?" : std::to_string(pids.front());
+    return any_alive(pids)
+               ? fmt::format("running now? runs/{} belongs to process {}, alive on this machine",
+                             name, pid)
+               : fmt::format(
+                     "interrupted: runs/{} was left by process {}, gone from this "
+                     "machine (killed, or the machine stopped)",
+                     name, pid);
+  }
+  return "";
+}
+
+}  // namespace
+
 SweepStatus sweep_status(const SweepManifest& m) {
   SweepStatus s;
+  const std::vector<fs::path> leftovers = leftover_temporaries(m, false);
   for (const auto& job : m.jobs) {
     JobStatus st = job_status(m, job);
     switch (st.state) {
@@ -1042,11 +1083,12 @@ SweepStatus sweep_status(const SweepManifest& m) {
         break;
       case JobState::kMissing:
         ++s.missing;
+        st.detail = interrupted_detail(job.id, leftovers);
         break;
     }
     s.jobs.push_back(std::move(st));
   }
-  for (const auto& p : leftover_temporaries(m, false)) s.leftovers.push_back(p.string());
+  for (const auto& p : leftovers) s.leftovers.push_back(p.string());
   return s;
 }
 
@@ -1062,17 +1104,7 @@ std::vector<fs::path> leftover_temporaries(const SweepManifest& m, bool remove) 
     const std::string name = p.filename().string();
     if (name.find(".tmp.") == std::string::npos && name.find(".old.") == std::string::npos)
       continue;
-    // Every number after a ".tmp." or ".old." is the pid of a process that made it.
-    bool alive = false;
-    for (std::size_t pos = 0; (pos = name.find('.', pos)) != std::string::npos; ++pos) {
-      if (name.compare(pos, 5, ".tmp.") != 0 && name.compare(pos, 5, ".old.") != 0) continue;
-      std::size_t end = pos + 5;
-      while (end < name.size() && std::isdigit(static_cast<unsigned char>(name[end]))) ++end;
-      std::int64_t pid = 0;
-      if (end > pos + 5 && yaml::parse_int64(name.substr(pos + 5, end - pos - 5), &pid))
-        alive = alive || process_alive(static_cast<pid_t>(pid));
-    }
-    if (remove && !alive) {
+    if (remove && !any_alive(temporary_pids(name))) {
       fs::remove_all(p, ec);
       continue;
     }

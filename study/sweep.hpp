@@ -180,7 +180,7 @@ struct JobStatus {
   std::string id;
   std::size_t index = 0;
   JobState state = JobState::kMissing;
-  std::string detail;  // failed: the failure; stale: why
+  std::string detail;  // failed: the failure; stale: why; missing: interrupted, if it was
 };
 
 /// The state of one job: done (marker with the manifest's hash), stale

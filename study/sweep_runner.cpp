@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -64,11 +65,12 @@ std::string tail_of(const std::string& text, std::size_t max_lines = 20) {
 }
 
 void write_failure(const SweepManifest& m, const SweepJob& job, const std::string& status,
-                   const std::string& error) {
+                   const std::string& error, const std::string& log_tail = "") {
   nlohmann::ordered_json j;
   j["id"] = job.id;
   j["status"] = status;
   j["error"] = error;
+  if (!log_tail.empty()) j["log_tail"] = log_tail;
   j["hash"] = job.hash;
   j["host"] = host_name();
   j["log"] = fs::relative(m.log_file(job.id), m.dir).string();
@@ -79,6 +81,37 @@ void write_failure(const SweepManifest& m, const SweepJob& job, const std::strin
 void clear_failure(const SweepManifest& m, const SweepJob& job) {
   std::error_code ec;
   fs::remove(m.failed_record(job.id), ec);
+}
+
+// What went wrong, for the record the runner writes when a job ends badly: the error
+// the job recorded itself (run_manifest_job), else the last line of its output.
+std::string job_error(const SweepManifest& m, const SweepJob& job, const std::string& log_tail) {
+  std::error_code ec;
+  if (fs::exists(m.failed_record(job.id), ec)) {
+    try {
+      const auto j = nlohmann::json::parse(read_text_file(m.failed_record(job.id), "record"));
+      const std::string error = j.value("error", "");
+      if (!error.empty()) return error;
+    } catch (const std::exception&) {
+      // Cut short (the job was killed while writing it): fall back to the log.
+    }
+  }
+  const auto nl = log_tail.rfind('\n');
+  return nl == std::string::npos ? log_tail : log_tail.substr(nl + 1);
+}
+
+// Past the timeout a job gets SIGTERM (driftlab exits; its children get SIGTERM with it),
+// and SIGKILL if it is still there kKillGrace_s later.
+void stop_if_past_timeout(pid_t pid, double elapsed_s, double timeout_s, int& signals_sent) {
+  constexpr double kKillGrace_s = 5;
+  if (timeout_s <= 0 || elapsed_s < timeout_s) return;
+  if (signals_sent == 0) {
+    ::kill(pid, SIGTERM);
+    signals_sent = 1;
+  } else if (signals_sent == 1 && elapsed_s >= timeout_s + kKillGrace_s) {
+    ::kill(pid, SIGKILL);
+    signals_sent = 2;
+  }
 }
 
 const SweepJob& job_or_throw(const SweepManifest& m, const std::string& id) {
@@ -214,6 +247,9 @@ std::string SweepRunSummary::brief() const {
 SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& options) {
   if (options.parallel < 1)
     throw UserError(fmt::format("--parallel: got {}, expected at least 1", options.parallel));
+  if (!(options.job_timeout_s >= 0) || !std::isfinite(options.job_timeout_s))
+    throw UserError(fmt::format("--job-timeout: got {}, expected seconds >= 0 (0: no limit)",
+                                options.job_timeout_s));
   std::error_code ec;
   if (!fs::is_regular_file(options.executable, ec))
     throw UserError(fmt::format("{}: no such executable, expected the driftlab binary",
@@ -241,6 +277,7 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
     pid_t pid;
     const SweepJob* job;
     Clock::time_point start;
+    int signals_sent = 0;  // past the timeout: 1 after SIGTERM, 2 after SIGKILL
   };
   std::vector<Running> running;
   SweepProgress progress;
@@ -257,6 +294,7 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
     spec.args = {"run", "--manifest", m.manifest.string(), "--job", job->id};
     if (options.force) spec.args.push_back("--force");
     spec.output_file = m.log_file(job->id);
+    clear_failure(m, *job);  // a record left when it ends is this attempt's
     running.push_back({spawn_process(spec), job, Clock::now()});
   };
   std::size_t next = 0;
@@ -272,6 +310,8 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
       for (std::size_t i = 0; i < running.size();) {
         const auto status = try_wait_process(running[i].pid);
         if (!status) {
+          stop_if_past_timeout(running[i].pid, seconds_since(running[i].start),
+                               options.job_timeout_s, running[i].signals_sent);
           ++i;
           continue;
         }
@@ -294,10 +334,23 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
           const std::string log = fs::exists(m.log_file(r.job->id), log_ec)
                                       ? read_text_file(m.log_file(r.job->id), "job log")
                                       : std::string();
-          std::string why =
-              status->ok() ? "exit code 0 but no completion marker" : status->describe();
+          std::string why = r.signals_sent > 0
+                                ? fmt::format(
+                                      "timeout: still running after --job-timeout {} s, "
+                                      "stopped ({})",
+                                      options.job_timeout_s, status->describe())
+                            : status->ok() ? "exit code 0 but no completion marker"
+                                           : status->describe();
+          if (options.local && r.signals_sent > 0) leftover_temporaries(m, /*remove=*/true);
+          try {
+            const std::string log_tail = tail_of(log);
+            write_failure(m, *r.job, why, job_error(m, *r.job, log_tail), log_tail);
+          } catch (const std::exception& e) {
+            // A full disk: the job stays `missing` and runs again; the others go on.
+            const std::string what = e.what();
+            why += fmt::format(" (and no failure record: {})", what.substr(0, what.find('\n')));
+          }
           progress.last_detail = why;
-          write_failure(m, *r.job, why, tail_of(log));
         }
         // The next job starts before the report, so that "running" counts it.
         while (running.size() < options.parallel && next < pending.size()) start(pending[next++]);

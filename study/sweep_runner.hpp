@@ -61,6 +61,9 @@ struct SweepRunOptions {
   /// second local runner refuses to start, and remove temporaries of killed jobs.
   /// False for shards, which run side by side on several machines.
   bool local = true;
+  /// A job still running after this many seconds is stopped (SIGTERM, SIGKILL 5 s later) and
+  /// recorded as `timeout`; 0: no limit. The guard against a job that hangs.
+  double job_timeout_s = 0;
   std::function<void(const SweepProgress&)> on_progress;
 };
 
@@ -77,8 +80,10 @@ struct SweepRunSummary {
 
 /// Runs every job that is not done (all with `force`) as a child process
 /// `EXECUTABLE run --manifest M --job ID`, at most `parallel` at once, its
-/// output in logs/ID.log. A job that fails or crashes gets failed/ID.json
-/// (exit status, the end of its output) and does not stop the others.
+/// output in logs/ID.log. A job that fails, crashes or runs past `job_timeout_s`
+/// gets failed/ID.json (what happened, the end of its output) and does not stop
+/// the others; a failure record that cannot be written (a full disk) does not
+/// stop them either (the job is then `missing` and runs again next time).
 SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& options);
 
 struct SlurmOptions {

@@ -254,5 +254,60 @@ TEST_F(SlurmCluster, ArrayOfShardsMergesLikeALocalRunAndResubmitsOnlyUnfinishedS
   EXPECT_TRUE(slurp(on_slurm / "summary/sections.csv") == slurp(local / "summary/sections.csv"));
 }
 
+// An array task that dies (SIGKILL once its first job is done, as when a node is lost or
+// the task is killed for memory): `sweep status` names the interrupted job and prints the
+// sbatch line for that task alone; resubmitting it finishes the sweep and keeps the job
+// the dead task had finished.
+TEST_F(SlurmCluster, AFailedArrayTaskIsResubmittedAloneAndFinishesTheSweep) {
+  const fs::path dir = root_ / "task_fails";
+  Result r = driftlab({"sweep", "plan", (kSource / "tests/data/sweeps/tiny_grid.yaml").string(),
+                       "--out", dir.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  // Task 1 (jobs p0000-r01 and p0001-r01) runs driftlab and kills it after its first job
+  // while the file FAULT exists.
+  const fs::path wrapper = root_ / "driftlab-on-a-bad-node", fault = root_ / "FAULT";
+  std::ofstream(wrapper) << "#!/bin/sh\n"
+                         << "case \"$*\" in *'--shard 1/2'*) if [ -e "
+                         << shell_quote(fault.string()) << " ]; then\n"
+                         << "  " << shell_quote(kCli.string()) << " \"$@\" & pid=$!\n"
+                         << "  while [ ! -e "
+                         << shell_quote((dir / "runs/p0000-r01/job.json").string())
+                         << " ]; do sleep 0.05; done\n"
+                         << "  kill -KILL $pid; exit 137\n"
+                         << "fi ;; esac\n"
+                         << "exec " << shell_quote(kCli.string()) << " \"$@\"\n";
+  fs::permissions(wrapper, fs::perms::owner_all | fs::perms::group_read | fs::perms::others_read);
+  std::ofstream(fault) << "1\n";
+  r = driftlab({"sweep", "slurm-script", dir.string(), "--shards", "2", "--max-parallel", "2",
+                "--partition", "debug", "--driftlab", wrapper.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  std::string states = submit_and_wait("sbatch " + (dir / "slurm/sweep.sbatch").string());
+  EXPECT_NE(states.find("_0 COMPLETED"), std::string::npos) << states;
+  EXPECT_NE(states.find("_1 FAILED"), std::string::npos) << states;
+
+  r = driftlab({"sweep", "status", dir.string()});
+  EXPECT_NE(r.out.find("4 jobs: 3 done, 0 failed, 0 stale, 1 missing"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("missing:\n  p0001-r01"), std::string::npos) << r.out;
+  const std::string resubmit = "sbatch --array=1%2 '" + (dir / "slurm/sweep.sbatch").string() + "'";
+  ASSERT_NE(r.out.find(resubmit), std::string::npos) << r.out;
+  for (const auto& e : fs::directory_iterator(dir / "runs")) {
+    const std::string name = e.path().filename().string();
+    if (name.find(".tmp.") != std::string::npos) {
+      const std::string id = name.substr(0, name.find('.'));
+      EXPECT_NE(r.out.find(id + "  interrupted: runs/" + id + ".tmp."), std::string::npos) << r.out;
+    } else {
+      EXPECT_TRUE(fs::exists(e.path() / "job.json")) << name << " looks finished but is not";
+    }
+  }
+
+  const std::string finished_by_the_dead_task = slurp(dir / "runs/p0000-r01/job.json");
+  fs::remove(fault);
+  states = submit_and_wait(resubmit);
+  EXPECT_NE(states.find("_1 COMPLETED"), std::string::npos) << states;
+  r = driftlab({"sweep", "status", dir.string()});
+  EXPECT_NE(r.out.find("4 jobs: 4 done, 0 failed, 0 stale, 0 missing"), std::string::npos) << r.out;
+  EXPECT_EQ(slurp(dir / "runs/p0000-r01/job.json"), finished_by_the_dead_task);
+}
+
 }  // namespace
 }  // namespace driftlab::study
