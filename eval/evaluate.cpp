@@ -72,6 +72,31 @@ void regress(const EvalOptions& options, Evaluation* e) {
 
 }  // namespace
 
+namespace {
+
+// A section whose frames include one where the VO lost track (frame table column `lost`,
+// 1 for such a frame) is marked, and Table 1 is also summarised without the marked ones, so
+// that a stretch of lost frames is not averaged into the errors unseen.
+void mark_lost_track_sections(const FrameTable* frames, Evaluation* e) {
+  if (!frames || !frames->column("lost") || e->sections.empty()) return;
+  std::vector<Section> tracked;
+  for (const Section& s : e->sections) {
+    if (s.covariate("lost") > 0)
+      e->lost_track_sections.push_back(s.index);
+    else
+      tracked.push_back(s);
+  }
+  e->tracked_summary = summarize_sections(tracked);
+  if (e->lost_track_sections.empty()) return;
+  e->warnings.push_back(fmt::format(
+      "{} of {} sections hold frames where the VO lost track: mean e'_p {:.4g} m/m over all "
+      "sections, {:.4g} m/m over the {} others (sections.tracked in metrics.json)",
+      e->lost_track_sections.size(), e->sections.size(), e->section_summary.p_m_per_m.mean,
+      e->tracked_summary->p_m_per_m.mean, tracked.size()));
+}
+
+}  // namespace
+
 Evaluation evaluate(const EvaluationInput& in) {
   yaml::validate_or_throw(in.options, "eval options");
   const EvalOptions& opt = in.options;
@@ -137,6 +162,7 @@ Evaluation evaluate(const EvaluationInput& in) {
   const FrameTable* frames = in.frames ? &*in.frames : nullptr;
   e.sections = compute_sections(t, gt, est, {opt.section_length_m}, frames);
   e.section_summary = summarize_sections(e.sections);
+  mark_lost_track_sections(frames, &e);
   if (!e.sections.empty())
     for (const auto& name : e.sections.front().covariate_names)
       e.covariates.emplace_back(name, summarize_covariate(e.sections, name));
@@ -252,15 +278,24 @@ nlohmann::json to_json(const Evaluation& e, const EvalOptions& options) {
   for (const auto& s : e.subtracks)
     j["subtracks"][s.name] = b.track(s.track, "subtracks." + s.name);
 
-  const SectionSummary& ss = e.section_summary;
+  // Table 1's rows into `out`; a non-finite value is named PREFIX.KEY in the warnings.
+  const auto table1 = [&](const SectionSummary& ss, const std::string& prefix,
+                          nlohmann::json& out) {
+    const std::pair<const char*, const Summary*> rows[] = {
+        {"p_m_per_m", &ss.p_m_per_m},           {"x_m_per_m", &ss.x_m_per_m},
+        {"y_m_per_m", &ss.y_m_per_m},           {"z_m_per_m", &ss.z_m_per_m},
+        {"roll_deg_per_m", &ss.roll_deg_per_m}, {"pitch_deg_per_m", &ss.pitch_deg_per_m},
+        {"yaw_deg_per_m", &ss.yaw_deg_per_m}};
+    for (const auto& [key, summary] : rows) out[key] = b.summary(*summary, prefix + key, true);
+  };
   j["sections"] = {{"section_length_m", options.section_length_m}, {"count", e.sections.size()}};
-  const std::pair<const char*, const Summary*> rows[] = {
-      {"p_m_per_m", &ss.p_m_per_m},           {"x_m_per_m", &ss.x_m_per_m},
-      {"y_m_per_m", &ss.y_m_per_m},           {"z_m_per_m", &ss.z_m_per_m},
-      {"roll_deg_per_m", &ss.roll_deg_per_m}, {"pitch_deg_per_m", &ss.pitch_deg_per_m},
-      {"yaw_deg_per_m", &ss.yaw_deg_per_m}};
-  for (const auto& [key, summary] : rows)
-    j["sections"][key] = b.summary(*summary, std::string("sections.") + key, true);
+  table1(e.section_summary, "sections.", j["sections"]);
+  if (e.tracked_summary) {
+    j["sections"]["with_lost_track"] = e.lost_track_sections;
+    nlohmann::json tracked = {{"count", e.sections.size() - e.lost_track_sections.size()}};
+    table1(*e.tracked_summary, "sections.tracked.", tracked);
+    j["sections"]["tracked"] = tracked;
+  }
   j["covariates"] = nlohmann::json::object();
   for (const auto& [name, summary] : e.covariates)
     j["covariates"][name] = b.summary(summary, "covariates." + name, true);
@@ -382,6 +417,20 @@ std::string tables_markdown(const Evaluation& e, const EvalOptions& options) {
   md += summary_row("ε'_roll", ss.roll_deg_per_m, 2, false);
   md += summary_row("ε'_pitch", ss.pitch_deg_per_m, 2, false);
   md += summary_row("ε'_yaw", ss.yaw_deg_per_m, 2, false);
+  if (e.tracked_summary && !e.lost_track_sections.empty()) {
+    const std::size_t n = e.lost_track_sections.size();
+    md += summary_row(fmt::format("ε'_p, without the {} sections where the VO lost track", n),
+                      e.tracked_summary->p_m_per_m, 3, true);
+    std::string which;
+    for (std::size_t i = 0; i < n && i < 20; ++i)
+      which += (i ? ", " : "") + std::to_string(e.lost_track_sections[i]);
+    if (n > 20) which += fmt::format(" and {} more", n - 20);
+    md += fmt::format(
+        "\nThe VO lost track in {} of the {} sections (index {}; their `lost` column in "
+        "sections.csv is the share of such frames): the rows above average through them, the "
+        "last row leaves them out.\n",
+        n, e.sections.size(), which);
+  }
 
   md +=
       "\n## Table 2. RMSE and maximum of the 3D and 2D position errors, m (% of track "

@@ -49,6 +49,10 @@ struct Evaluation {
   std::vector<SubtrackEvaluation> subtracks;
   std::vector<Section> sections;
   SectionSummary section_summary;
+  // Sections holding frames where the VO lost track (a `lost` column in the frame table,
+  // section mean > 0), and Table 1 over the other sections; both empty without the column.
+  std::vector<std::size_t> lost_track_sections;  // Section::index of each
+  std::optional<SectionSummary> tracked_summary;
   std::vector<std::pair<std::string, Summary>> covariates;  // Table 4
   std::optional<OlsResult> regression;                      // Table 3
   std::string regression_skipped;                           // why, when not run

@@ -127,6 +127,33 @@ SE3 FilterTrack::step(TimeNs t_ns, const vo::VoResult& vo) {
 
 bool FilterTrack::writes_states() const { return !impl_->eskf; }
 
+FilterCounts FilterTrack::counts() const {
+  const Impl& s = *impl_;
+  FilterCounts c;
+  if (s.eskf) {
+    const fusion::EskfStats& e = s.eskf->stats();
+    c.nonfinite_guards = e.nonfinite_guards;
+    c.counts = {{"imu_samples", e.imu_samples},     {"vo_fused", e.vo_fused},
+                {"vo_skipped", e.vo_skipped},       {"vo_gated", e.vo_gated},
+                {"gps_fused", e.gps_fused},         {"gps_gated", e.gps_gated},
+                {"heading_fused", e.heading_fused}, {"heading_gated", e.heading_gated}};
+  } else {
+    std::int64_t vo = 0, heading = 0, resampled = 0;
+    for (const auto& e : s.states) {
+      vo += e.vo_fused;
+      heading += e.heading_fused;
+      resampled += e.resampled;
+    }
+    c.nonfinite_guards = s.kf ? s.kf->nonfinite_guards() : s.pf->nonfinite_guards();
+    c.counts = {{"steps", static_cast<std::int64_t>(s.states.size())},
+                {"vo_fused", vo},
+                {"heading_fused", heading}};
+    if (s.pf) c.counts["resampled"] = resampled;
+  }
+  c.counts["nonfinite_guards"] = c.nonfinite_guards;
+  return c;
+}
+
 void FilterTrack::write_states(const std::filesystem::path& path) const {
   fusion::write_ned_csv(path, impl_->states);
 }

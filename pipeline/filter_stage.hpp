@@ -5,8 +5,10 @@
 // the estimates overlay), the start attitude comes from the sensors.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "core/rng.hpp"
 #include "core/se3.hpp"
@@ -15,6 +17,14 @@
 #include "vo/stereo_odometry.hpp"
 
 namespace driftlab::pipeline {
+
+/// What a filter did over a run (MuJoCo's warning counters, reported): the measurements it
+/// fused, skipped and gated, and its non-finite guards (inputs skipped or states restarted;
+/// never expected, so each one is a warning).
+struct FilterCounts {
+  std::int64_t nonfinite_guards = 0;
+  nlohmann::ordered_json counts;  // every counter of the filter, nonfinite_guards included
+};
 
 class FilterTrack {
  public:
@@ -29,6 +39,8 @@ class FilterTrack {
   /// NED filters: writes their per-step state (N, E, u, v, heading) as CSV at `path`.
   void write_states(const std::filesystem::path& path) const;
   bool writes_states() const;
+  /// The filter's counters so far.
+  FilterCounts counts() const;
 
  private:
   struct Impl;

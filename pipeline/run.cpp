@@ -195,6 +195,29 @@ std::string report_tracking(const std::vector<Track>& tracks, const Trajectory& 
   return names.empty() ? "" : tracking_table_markdown(names, summaries);
 }
 
+// What each filter and smoother did (algorithms.NAME.filter: measurements fused, skipped,
+// gated; non-finite guards), and a warning for every guard that fired.
+void report_filter_counts(const std::vector<Track>& tracks, nlohmann::json* metrics,
+                          std::vector<std::string>* warnings) {
+  for (const Track& tr : tracks) {
+    FilterCounts c;
+    if (tr.filter) {
+      c = tr.filter->counts();
+    } else if (tr.smoother) {
+      c.nonfinite_guards = tr.smoother->nonfinite_guards();
+      c.counts = {{"nonfinite_guards", c.nonfinite_guards}};
+    } else {
+      continue;
+    }
+    (*metrics)["algorithms"][tr.name]["filter"] = c.counts;
+    if (c.nonfinite_guards > 0)
+      warnings->push_back(fmt::format(
+          "{}: {} non-finite inputs or states were caught (skipped, or the filter restarted); "
+          "see algorithms.{}.filter in metrics.json",
+          tr.name, c.nonfinite_guards, tr.name));
+  }
+}
+
 // Each filter's estimate against its raw VO's, by APE translation RMSE (the same evaluation,
 // the same frames): `vs_raw_vo` in the filter's metrics, a report table, and a warning for each
 // filter that is worse than the VO it filters, so that a filter that does not help says so.
@@ -510,6 +533,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   write_file_atomic(dir / "sections.csv", sections);
   report += report_tracking(tracks, camera_gt, metrics, &warnings);
   report += compare_filters_with_raw_vo(tracks, metrics, &warnings);
+  report_filter_counts(tracks, metrics, &warnings);
 
   write_report(sc, tracks, camera_gt, dir, sample_frame, sections, report, *metrics, &warnings);
   (*metrics)["timing"]["render_s"] = render_s;

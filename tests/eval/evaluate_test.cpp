@@ -1,5 +1,6 @@
 #include "eval/evaluate.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -107,6 +108,66 @@ TEST(Evaluate, JsonHasTheDocumentedKeysAndNoNonFiniteNumbers) {
   EXPECT_EQ(j.dump().find("NaN"), std::string::npos);
   EXPECT_FALSE(tables_markdown(e, in.options).empty());
   EXPECT_NE(sections_csv(e).find("algorithm,index,t_start_s"), std::string::npos);
+}
+
+// A VO that lost track for frames 101..110 gave no motion there: its estimate stands still
+// at frame 100's pose and then goes on exactly, displaced. The sections whose frames include
+// a lost one are marked; every other section is exact, so Table 1 without them is zero.
+TEST(Evaluate, SectionsWhereTheVoLostTrackAreMarkedNotAveragedThroughUnseen) {
+  const Trajectory gt = serpentine();
+  Trajectory est = gt;
+  const SE3 shift = gt[100].T_W_C * gt[110].T_W_C.inverse();
+  for (std::size_t i = 101; i < est.size(); ++i)
+    est[i].T_W_C = i <= 110 ? gt[100].T_W_C : shift * gt[i].T_W_C;
+  EvaluationInput in = input_with(gt, est);
+  FrameTable frames;
+  frames.names = {"lost"};
+  frames.columns.resize(1);
+  for (std::size_t i = 0; i < gt.size(); ++i) {
+    frames.t_ns.push_back(gt[i].t_ns);
+    frames.columns[0].push_back(i >= 101 && i <= 110 ? 1.0 : 0.0);
+  }
+  in.frames = frames;
+  const Evaluation e = evaluate(in);
+  ASSERT_GT(e.sections.size(), 25u);
+  std::vector<std::size_t> expected;  // sections whose first..last frames include 101..110
+  double sum_all = 0;
+  for (const auto& sec : e.sections) {
+    sum_all += sec.per_m(sec.err_p_m);
+    if (sec.last >= 101 && sec.first <= 110) {
+      expected.push_back(sec.index);
+    } else {
+      EXPECT_LT(sec.err_p_m, 1e-9) << "section " << sec.index;
+    }
+  }
+  EXPECT_EQ(e.lost_track_sections, expected);
+  ASSERT_GE(expected.size(), 1u);
+  ASSERT_TRUE(e.tracked_summary);
+  EXPECT_EQ(e.tracked_summary->p_m_per_m.n, e.sections.size() - expected.size());
+  EXPECT_LT(e.tracked_summary->p_m_per_m.max, 1e-9);
+  EXPECT_NEAR(e.section_summary.p_m_per_m.mean, sum_all / e.sections.size(), 1e-12);
+  EXPECT_GT(e.section_summary.p_m_per_m.mean, 0.01);  // averaged through the lost stretch
+
+  const nlohmann::json j = to_json(e, in.options);
+  EXPECT_EQ(j["sections"]["with_lost_track"].get<std::vector<std::size_t>>(), expected);
+  EXPECT_EQ(j["sections"]["tracked"]["count"], e.sections.size() - expected.size());
+  EXPECT_LT(j["sections"]["tracked"]["p_m_per_m"]["max"].get<double>(), 1e-9);
+  EXPECT_NE(
+      tables_markdown(e, in.options)
+          .find(fmt::format("without the {} sections where the VO lost track", expected.size())),
+      std::string::npos);
+  bool warned = false;
+  for (const auto& w : e.warnings)
+    warned = warned || w.find("sections hold frames where the VO lost track") != std::string::npos;
+  EXPECT_TRUE(warned);
+
+  // Without a lost frame nothing is marked and nothing is said.
+  for (double& v : in.frames->columns[0]) v = 0.0;
+  in.est = gt;
+  const Evaluation clean = evaluate(in);
+  EXPECT_TRUE(clean.lost_track_sections.empty());
+  EXPECT_EQ(clean.tracked_summary->p_m_per_m.n, clean.sections.size());
+  EXPECT_EQ(tables_markdown(clean, in.options).find("lost track"), std::string::npos);
 }
 
 TEST(Evaluate, RegressionRecoversAKnownDependence) {

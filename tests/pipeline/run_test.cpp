@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -300,11 +301,52 @@ TEST(Run, EachFilterIsSetAgainstItsRawVoAndOneThatDoesNotHelpSaysSo) {
   sc.pipeline.max_frames = 80;
   sc.pipeline.vo = {"pnp"};
   sc.pipeline.fusion = {FusionAlgorithm::kCaSmoother, FusionAlgorithm::kNedKf,
-                        FusionAlgorithm::kNedPf};
+                        FusionAlgorithm::kNedPf, FusionAlgorithm::kEskf};
   run_scenario(sc, out, {});
   const auto m = nlohmann::json::parse(slurp(out / "metrics.json"));
   const std::string report = slurp(out / "report.md");
   EXPECT_NE(report.find("## Filters against their raw VO"), std::string::npos);
+
+  // What each filter fused, counted again from the files the run wrote: frames.csv's
+  // pnp_valid column, the compass and IMU files (one row per sample after the header).
+  auto rows = [&](const char* file) {
+    const std::string text = slurp(out / file);
+    return static_cast<std::int64_t>(std::count(text.begin(), text.end(), '\n')) - 1;
+  };
+  std::int64_t valid = 0;
+  {
+    std::istringstream frames(slurp(out / "frames.csv"));
+    std::string line, cell;
+    std::getline(frames, line);
+    const std::string before = line.substr(0, line.find(",pnp_valid,"));
+    const auto column = std::count(before.begin(), before.end(), ',') + 1;
+    while (std::getline(frames, line)) {
+      std::istringstream cells(line);
+      for (auto i = 0; i <= column; ++i) std::getline(cells, cell, ',');
+      valid += cell == "1";
+    }
+  }
+  const std::int64_t delivered = m["camera"]["frames_delivered"].get<std::int64_t>();
+  for (const char* f : {"pnp_ned_kf", "pnp_ned_pf"}) {
+    SCOPED_TRACE(f);
+    const auto& c = m["algorithms"][f]["filter"];
+    EXPECT_EQ(c["steps"].get<std::int64_t>(), delivered);
+    EXPECT_EQ(c["vo_fused"].get<std::int64_t>(), valid);
+    EXPECT_EQ(c["heading_fused"].get<std::int64_t>(), rows("compass.csv"));
+    EXPECT_EQ(c["nonfinite_guards"].get<std::int64_t>(), 0);
+  }
+  const auto& e = m["algorithms"]["pnp_eskf"]["filter"];
+  EXPECT_EQ(e["imu_samples"].get<std::int64_t>(), rows("imu.csv"));
+  EXPECT_EQ(e["vo_fused"].get<std::int64_t>() + e["vo_skipped"].get<std::int64_t>() +
+                e["vo_gated"].get<std::int64_t>(),
+            delivered);
+  EXPECT_EQ(e["heading_fused"].get<std::int64_t>() + e["heading_gated"].get<std::int64_t>(),
+            rows("compass.csv"));
+  EXPECT_EQ(e["nonfinite_guards"].get<std::int64_t>(), 0);
+  EXPECT_EQ(m["algorithms"]["pnp_ca"]["filter"]["nonfinite_guards"].get<std::int64_t>(), 0);
+  EXPECT_FALSE(m["algorithms"]["pnp"].contains("filter"));  // a VO is not a filter
+  for (const auto& w : m["warnings"])
+    EXPECT_EQ(w.get<std::string>().find("non-finite"), std::string::npos) << w;
   const double raw = m["algorithms"]["pnp"]["ape"]["trans_m"]["rmse"].get<double>();
   EXPECT_FALSE(m["algorithms"]["pnp"].contains("vs_raw_vo"));  // a VO is not a filter
   for (const char* f : {"pnp_ca", "pnp_ned_kf", "pnp_ned_pf"}) {
