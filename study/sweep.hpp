@@ -71,6 +71,12 @@ struct Sweep {
   std::vector<SweepAxis> axes;
 };
 
+namespace detail {
+/// Rounds a generated axis value to 12 significant digits, so that range {0, 1, 0.1} gives
+/// 0.3 rather than 0.30000000000000004 (and never -0).
+double tidy_level(double v);
+}  // namespace detail
+
 /// Reads and checks a sweep file: unknown keys, wrong types, empty axes,
 /// replicates 0, conflicting design settings. Throws UserError listing every
 /// problem as FILE:LINE:COL: key.path: got VALUE, expected WHAT. Key paths and

@@ -21,6 +21,7 @@
 #include "eval/regression.hpp"
 #include "eval/stats.hpp"
 #include "pipeline/scenario.hpp"
+#include "study/run_regressions.hpp"
 
 namespace driftlab::study {
 
@@ -96,21 +97,6 @@ double cell_number(const std::string& s) {
   return v;
 }
 
-// A number at a dotted key path of a JSON document, NaN when absent or not a number.
-double json_number(const nlohmann::json& j, const std::string& dotted) {
-  const nlohmann::json* node = &j;
-  std::size_t start = 0;
-  while (start <= dotted.size()) {
-    const auto dot = dotted.find('.', start);
-    const std::string key = dotted.substr(start, dot == std::string::npos ? dot : dot - start);
-    if (!node->is_object() || !node->contains(key)) return kNaN;
-    node = &(*node)[key];
-    if (dot == std::string::npos) break;
-    start = dot + 1;
-  }
-  return node->is_number() ? node->get<double>() : kNaN;
-}
-
 struct Stat {
   std::size_t n = 0;
   double mean = kNaN, sd = kNaN, lo = kNaN, hi = kNaN;
@@ -148,131 +134,6 @@ std::string file_safe(const std::string& s) {
   return out;
 }
 
-// One merged run.
-struct RunData {
-  const SweepJob* job;
-  nlohmann::json metrics;
-};
-
-// An OLS fit into metrics.json (n, R^2, F, each coefficient) and summary.md (a table and
-// the fit's paragraph).
-void append_ols(const eval::OlsResult& r, nlohmann::ordered_json* j, std::string* md) {
-  (*j)["n"] = r.n;
-  (*j)["r2"] = jnum(r.r2);
-  (*j)["adj_r2"] = jnum(r.adj_r2);
-  (*j)["f"] = jnum(r.f);
-  (*j)["f_p"] = jnum(r.f_p);
-  (*j)["sigma"] = jnum(r.sigma);
-  (*j)["coefficients"] = nlohmann::ordered_json::object();
-  *md += "| term | estimate | std. error | t | p | VIF |\n|---|---|---|---|---|---|\n";
-  for (const auto& c : r.coefficients) {
-    (*j)["coefficients"][c.name] = {{"estimate", jnum(c.estimate)},
-                                    {"std_error", jnum(c.std_error)},
-                                    {"t", jnum(c.t)},
-                                    {"p", jnum(c.p)},
-                                    {"vif", jnum(c.vif)},
-                                    {"significant", c.significant}};
-    *md += fmt::format("| {}{} | {:.4g} | {:.3g} | {:.3g} | {:.3g} | {} |\n", c.name,
-                       c.significant ? " *" : "", c.estimate, c.std_error, c.t, c.p,
-                       c.name == "Intercept" ? std::string("") : fmt::format("{:.3g}", c.vif));
-  }
-  (*j)["warnings"] = r.warnings;
-  *md += "\n" + r.brief() + "\n";
-}
-
-// One --regress: a run metric (its runs.csv name, or a key path under algorithms.ALGO) on
-// swept axes.
-struct RunRegression {
-  std::string text, metric;
-  std::vector<std::string> axes;
-};
-
-std::vector<RunRegression> parse_run_regressions(const std::vector<std::string>& specs,
-                                                 const SweepManifest& m) {
-  std::vector<RunRegression> out;
-  for (const auto& spec : specs) {
-    RunRegression r{spec, "", {}};
-    const auto tilde = spec.find('~');
-    if (tilde == std::string::npos || tilde == 0 || tilde + 1 == spec.size())
-      throw UserError(
-          fmt::format("--regress: got '{}', expected METRIC~AXIS[+AXIS...], e.g. "
-                      "basin_north_rmse_m~amplitude_m",
-                      spec));
-    r.metric = spec.substr(0, tilde);
-    std::string rest = spec.substr(tilde + 1);
-    for (std::size_t start = 0; start <= rest.size();) {
-      const auto plus = rest.find('+', start);
-      r.axes.push_back(rest.substr(start, plus == std::string::npos ? plus : plus - start));
-      if (plus == std::string::npos) break;
-      start = plus + 1;
-    }
-    for (const auto& a : r.axes) {
-      bool known = false;
-      std::string names;
-      for (const auto& ax : m.axes) {
-        known = known || (ax.name == a && ax.numeric);
-        if (ax.numeric) names += (names.empty() ? "" : ", ") + ax.name;
-      }
-      if (!known)
-        throw UserError(
-            fmt::format("--regress '{}': got axis '{}', expected a numeric axis of the sweep: {}",
-                        spec, a, names));
-    }
-    out.push_back(r);
-  }
-  return out;
-}
-
-// The value of a --regress metric in one run: a run metric by name, else a key path.
-double regression_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
-                               const std::string& metric);
-
-// Fits each --regress over the runs of `algorithm` into j and md.
-void run_regressions(const std::vector<RunRegression>& specs, const std::vector<RunData>& runs,
-                     const std::string& algorithm, nlohmann::ordered_json* j, std::string* md,
-                     std::vector<std::string>* warnings) {
-  for (const auto& spec : specs) {
-    std::vector<double> y;
-    std::vector<std::vector<double>> columns(spec.axes.size());
-    for (const auto& r : runs) {
-      const double v = regression_metric_value(r.metrics, algorithm, spec.metric);
-      std::vector<double> x;
-      for (const auto& axis : spec.axes)
-        for (const auto& [name, value] : r.job->params)
-          if (name == axis) x.push_back(std::strtod(value.c_str(), nullptr));
-      if (!std::isfinite(v) || x.size() != spec.axes.size()) continue;
-      y.push_back(v);
-      for (std::size_t k = 0; k < x.size(); ++k) columns[k].push_back(x[k]);
-    }
-    nlohmann::ordered_json jr;
-    *md += fmt::format("\nRegression of `{}` on `{}` over the runs:\n\n", spec.metric,
-                       fmt::join(spec.axes, "`, `"));
-    try {
-      if (y.size() < spec.axes.size() + 2)
-        throw UserError(fmt::format("got {} runs with a value, need at least {}", y.size(),
-                                    spec.axes.size() + 2));
-      append_ols(eval::ols(y, columns, spec.axes), &jr, md);
-    } catch (const UserError& e) {
-      jr["skipped"] = e.what();
-      *md += std::string("Not fitted: ") + e.what() + "\n";
-      warnings->push_back(
-          fmt::format("{}: --regress {} not fitted: {}", algorithm, spec.text, e.what()));
-    }
-    (*j)[spec.text] = jr;
-  }
-}
-
-}  // namespace
-
-namespace {
-
-double regression_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
-                               const std::string& metric) {
-  for (const auto& rm : run_metrics())
-    if (rm.name == metric) return run_metric_value(metrics, algorithm, rm);
-  return json_number(metrics, "algorithms." + algorithm + "." + metric);
-}
-
 }  // namespace
 
 double run_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
@@ -292,12 +153,11 @@ std::string MergeSummary::brief() const {
                      algos.empty() ? "no algorithms" : algos, dir.string(), plots.size());
 }
 
-MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
-  MergeSummary out;
-  out.dir = m.dir / "summary";
-  const std::vector<RunRegression> regressions = parse_run_regressions(o.run_regressions, m);
-  const SweepStatus status = sweep_status(m);
-  if (!status.complete() && !o.allow_missing) {
+namespace {
+
+// Merging needs every job done, unless allow_missing; and at least one.
+void require_done_jobs(const SweepManifest& m, const SweepStatus& status, bool allow_missing) {
+  if (!status.complete() && !allow_missing) {
     std::string list;
     std::size_t shown = 0;
     for (const auto& st : status.jobs) {
@@ -318,31 +178,74 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
         fmt::format("{}: no job is done yet, expected at least one finished run "
                     "to merge",
                     m.dir.string()));
+}
 
-  // -------------------------------------------------------------------------
-  // Gather: every done run, in manifest order.
+// One row of a run's sections.csv in the pool.
+struct PooledSection {
+  std::size_t run;
+  std::map<std::string, std::string> cells;
+};
+
+// Every done run in manifest order, its sections, and the pooled table's columns.
+struct Pool {
   std::vector<RunData> runs;
+  std::vector<PooledSection> sections;
+  std::vector<std::string> algorithms;  // in order of first appearance
+  std::vector<std::string> header;      // job, point, replicate, seed, axes, run columns
+
+  // A cell of the pooled table: the job's own columns, its parameters, then the run's cells.
+  std::string value_of(const PooledSection& s, const std::string& column) const {
+    const RunData& r = runs[s.run];
+    if (column == "job") return r.job->id;
+    if (column == "point") return std::to_string(r.job->point);
+    if (column == "replicate") return std::to_string(r.job->replicate);
+    if (column == "seed") return std::to_string(r.job->seed);
+    for (const auto& [name, value] : r.job->params)
+      if (name == column) return value;
+    const auto it = s.cells.find(column);
+    return it == s.cells.end() ? std::string() : it->second;
+  }
+  bool is_column(const std::string& c) const {
+    return std::find(header.begin(), header.end(), c) != header.end();
+  }
+  std::string column_list() const {
+    std::string s;
+    for (std::size_t k = 4; k < header.size(); ++k) s += (s.empty() ? "" : ", ") + header[k];
+    return s;
+  }
+  std::vector<const PooledSection*> sections_of(const std::string& algorithm) const {
+    std::vector<const PooledSection*> rows;
+    for (const auto& s : sections) {
+      const auto it = s.cells.find("algorithm");
+      if (it != s.cells.end() && it->second == algorithm) rows.push_back(&s);
+    }
+    return rows;
+  }
+};
+
+RunData read_run(const SweepManifest& m, const SweepJob& job) {
+  RunData rd{&job, nlohmann::json::object()};
+  const fs::path metrics_file = m.run_dir(job.id) / "metrics.json";
+  std::error_code ec;
+  if (fs::exists(metrics_file, ec)) {
+    try {
+      rd.metrics = nlohmann::json::parse(read_text_file(metrics_file, "metrics.json"));
+    } catch (const nlohmann::json::parse_error& e) {
+      throw UserError(fmt::format("{}: not valid JSON ({}), expected the run's metrics",
+                                  metrics_file.string(), e.what()));
+    }
+  }
+  return rd;
+}
+
+Pool gather_runs(const SweepManifest& m, const SweepStatus& status) {
+  Pool pool;
   std::vector<std::string> run_columns;  // union of the runs' sections.csv columns
-  struct Section {
-    std::size_t run;
-    std::map<std::string, std::string> cells;
-  };
-  std::vector<Section> sections;
   for (const auto& st : status.jobs) {
     if (st.state != JobState::kDone) continue;
     const SweepJob& job = m.jobs[st.index];
-    RunData rd{&job, nlohmann::json::object()};
-    const fs::path metrics_file = m.run_dir(job.id) / "metrics.json";
-    std::error_code ec;
-    if (fs::exists(metrics_file, ec)) {
-      try {
-        rd.metrics = nlohmann::json::parse(read_text_file(metrics_file, "metrics.json"));
-      } catch (const nlohmann::json::parse_error& e) {
-        throw UserError(fmt::format("{}: not valid JSON ({}), expected the run's metrics",
-                                    metrics_file.string(), e.what()));
-      }
-    }
     const fs::path sections_file = m.run_dir(job.id) / "sections.csv";
+    std::error_code ec;
     if (fs::exists(sections_file, ec)) {
       const Table t = read_csv(sections_file);
       for (const auto& h : t.header) {
@@ -357,73 +260,62 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
                             m.dir.string(), h));
       }
       for (const auto& row : t.rows) {
-        Section s{runs.size(), {}};
+        PooledSection s{pool.runs.size(), {}};
         for (std::size_t k = 0; k < row.size(); ++k) s.cells[t.header[k]] = row[k];
-        sections.push_back(std::move(s));
+        pool.sections.push_back(std::move(s));
       }
     }
-    runs.push_back(std::move(rd));
+    pool.runs.push_back(read_run(m, job));
   }
-  out.runs = runs.size();
-  out.sections = sections.size();
-
   // Algorithms, in order of first appearance (runs in manifest order, names sorted).
-  for (const auto& r : runs)
+  auto add_algorithm = [&](const std::string& name) {
+    if (std::find(pool.algorithms.begin(), pool.algorithms.end(), name) == pool.algorithms.end())
+      pool.algorithms.push_back(name);
+  };
+  for (const auto& r : pool.runs)
     if (r.metrics.contains("algorithms") && r.metrics["algorithms"].is_object())
-      for (const auto& [name, _] : r.metrics["algorithms"].items())
-        if (std::find(out.algorithms.begin(), out.algorithms.end(), name) == out.algorithms.end())
-          out.algorithms.push_back(name);
-  for (const auto& s : sections) {
+      for (const auto& [name, _] : r.metrics["algorithms"].items()) add_algorithm(name);
+  for (const auto& s : pool.sections) {
     const auto it = s.cells.find("algorithm");
-    if (it != s.cells.end() &&
-        std::find(out.algorithms.begin(), out.algorithms.end(), it->second) == out.algorithms.end())
-      out.algorithms.push_back(it->second);
+    if (it != s.cells.end()) add_algorithm(it->second);
   }
+  pool.header = {"job", "point", "replicate", "seed"};
+  for (const auto& a : m.axes) pool.header.push_back(a.name);
+  pool.header.insert(pool.header.end(), run_columns.begin(), run_columns.end());
+  return pool;
+}
 
-  // -------------------------------------------------------------------------
-  // The pooled table.
-  std::vector<std::string> header = {"job", "point", "replicate", "seed"};
-  for (const auto& a : m.axes) header.push_back(a.name);
-  header.insert(header.end(), run_columns.begin(), run_columns.end());
-  auto value_of = [&](const Section& s, const std::string& column) -> std::string {
-    const RunData& r = runs[s.run];
-    if (column == "job") return r.job->id;
-    if (column == "point") return std::to_string(r.job->point);
-    if (column == "replicate") return std::to_string(r.job->replicate);
-    if (column == "seed") return std::to_string(r.job->seed);
-    for (const auto& [name, value] : r.job->params)
-      if (name == column) return value;
-    const auto it = s.cells.find(column);
-    return it == s.cells.end() ? std::string() : it->second;
-  };
-  std::string pooled_csv = csv_row(header);
-  for (const auto& s : sections) {
+std::string pooled_sections_csv(const Pool& pool) {
+  std::string csv = csv_row(pool.header);
+  for (const auto& s : pool.sections) {
     std::vector<std::string> row;
-    for (const auto& h : header) row.push_back(value_of(s, h));
-    pooled_csv += csv_row(row);
+    for (const auto& h : pool.header) row.push_back(pool.value_of(s, h));
+    csv += csv_row(row);
   }
+  return csv;
+}
 
-  // -------------------------------------------------------------------------
-  // Regression on the pool, per algorithm.
-  auto is_column = [&](const std::string& c) {
-    return std::find(header.begin(), header.end(), c) != header.end();
-  };
-  auto column_list = [&] {
-    std::string s;
-    for (std::size_t k = 4; k < header.size(); ++k) s += (s.empty() ? "" : ", ") + header[k];
-    return s;
-  };
-  if (!is_column(o.response) && !sections.empty())
+// The covariates of the pooled regression: --covariates, checked against the pool; by default
+// the base scenario's eval.regression_covariates that the pool has, and every numeric axis
+// that varies.
+struct Covariates {
+  std::vector<std::string> names;
+  bool by_default = false;
+};
+
+Covariates pooled_covariates(const SweepManifest& m, const MergeOptions& o, const Pool& pool,
+                             std::vector<std::string>* warnings) {
+  if (!pool.is_column(o.response) && !pool.sections.empty())
     throw UserError(
         fmt::format("--response: got '{}', expected a column of the pooled sections: "
                     "{}",
-                    o.response, column_list()));
+                    o.response, pool.column_list()));
   for (const auto& c : o.covariates)
-    if (!is_column(c) || c == "job" || c == "point" || c == "replicate" || c == "seed")
-      throw UserError(
-          fmt::format("--covariates: got '{}', expected a column of the pooled "
-                      "sections: {}",
-                      c, sections.empty() ? "(none: no run has sections)" : column_list()));
+    if (!pool.is_column(c) || c == "job" || c == "point" || c == "replicate" || c == "seed")
+      throw UserError(fmt::format(
+          "--covariates: got '{}', expected a column of the pooled "
+          "sections: {}",
+          c, pool.sections.empty() ? "(none: no run has sections)" : pool.column_list()));
   for (const auto& c : o.covariates)
     for (const auto& a : m.axes)
       if (a.name == c && !a.numeric)
@@ -431,185 +323,204 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
             fmt::format("--covariates: got '{}', expected a numeric column (the "
                         "axis '{}' has values that are not numbers)",
                         c, a.key));
-  std::vector<std::string> covariates = o.covariates;
-  bool default_covariates = covariates.empty();
-  if (default_covariates) {
-    std::vector<std::string> base_covariates{"v", "h", "f", "d"};
-    try {
-      const Scenario base = parse_scenario(read_text_file(m.scenario_file(), "scenario file"),
-                                           m.scenario_file().string(), m.base_dir());
-      base_covariates = base.eval.regression_covariates;
-    } catch (const UserError&) {
-      // The plan checked scenario.yaml; if it was edited since, the runs say what is there.
-    }
-    for (const auto& c : base_covariates) {
-      if (is_column(c)) {
-        covariates.push_back(c);
-      } else if (!sections.empty()) {
-        out.warnings.push_back(
-            fmt::format("regression: covariate '{}' of the base scenario is "
-                        "not in the pooled sections; left out",
-                        c));
-      }
-    }
-    for (const auto& a : m.axes) {
-      if (!a.numeric) continue;
-      std::set<std::string> distinct;
-      for (const auto& r : runs)
-        for (const auto& [name, value] : r.job->params)
-          if (name == a.name) distinct.insert(value);
-      if (distinct.size() > 1) covariates.push_back(a.name);
+  Covariates out{o.covariates, o.covariates.empty()};
+  if (!out.by_default) return out;
+  std::vector<std::string> base_covariates{"v", "h", "f", "d"};
+  try {
+    const Scenario base = parse_scenario(read_text_file(m.scenario_file(), "scenario file"),
+                                         m.scenario_file().string(), m.base_dir());
+    base_covariates = base.eval.regression_covariates;
+  } catch (const UserError&) {
+    // The plan checked scenario.yaml; if it was edited since, the runs say what is there.
+  }
+  for (const auto& c : base_covariates) {
+    if (pool.is_column(c)) {
+      out.names.push_back(c);
+    } else if (!pool.sections.empty()) {
+      warnings->push_back(
+          fmt::format("regression: covariate '{}' of the base scenario is "
+                      "not in the pooled sections; left out",
+                      c));
     }
   }
+  for (const auto& a : m.axes) {
+    if (!a.numeric) continue;
+    std::set<std::string> distinct;
+    for (const auto& r : pool.runs)
+      for (const auto& [name, value] : r.job->params)
+        if (name == a.name) distinct.insert(value);
+    if (distinct.size() > 1) out.names.push_back(a.name);
+  }
+  return out;
+}
 
-  nlohmann::ordered_json metrics;
-  metrics["sweep"] = {{"name", m.info.value("name", "")},
-                      {"design", m.info.value("design", "")},
-                      {"jobs", m.jobs.size()},
-                      {"merged_runs", runs.size()},
-                      {"points", m.info.value("points", 0)},
-                      {"replicates", m.info.value("replicates", 1)},
-                      {"sections", sections.size()}};
-  metrics["sweep"]["axes"] = nlohmann::ordered_json::array();
-  for (const auto& a : m.axes)
-    metrics["sweep"]["axes"].push_back({{"key", a.key}, {"name", a.name}});
-  metrics["algorithms"] = nlohmann::ordered_json::object();
+// metrics.json's `sweep` block.
+nlohmann::ordered_json sweep_info_json(const SweepManifest& m, const Pool& pool) {
+  nlohmann::ordered_json j = {{"name", m.info.value("name", "")},
+                              {"design", m.info.value("design", "")},
+                              {"jobs", m.jobs.size()},
+                              {"merged_runs", pool.runs.size()},
+                              {"points", m.info.value("points", 0)},
+                              {"replicates", m.info.value("replicates", 1)},
+                              {"sections", pool.sections.size()}};
+  j["axes"] = nlohmann::ordered_json::array();
+  for (const auto& a : m.axes) j["axes"].push_back({{"key", a.key}, {"name", a.name}});
+  return j;
+}
 
+// summary.md's title, design and axes.
+std::string summary_head_md(const SweepManifest& m, const Pool& pool) {
   std::string md = fmt::format("# Sweep {}\n\n", m.info.value("name", ""));
   if (!m.info.value("description", "").empty()) md += m.info.value("description", "") + "\n\n";
   md += fmt::format(
       "Design {}, {} points x {} replicates = {} jobs; {} runs merged, {} sections "
       "pooled.\n\nAxes:\n\n",
       m.info.value("design", ""), m.info.value("points", 0), m.info.value("replicates", 1),
-      m.jobs.size(), runs.size(), sections.size());
+      m.jobs.size(), pool.runs.size(), pool.sections.size());
   for (const auto& a : m.axes)
     md += a.name == a.key ? fmt::format("- `{}`\n", a.key)
                           : fmt::format("- `{}` (column `{}`)\n", a.key, a.name);
-  if (runs.size() < m.jobs.size())
+  if (pool.runs.size() < m.jobs.size())
     md += fmt::format("\n**{} of {} jobs are not done; this summary covers the finished ones.**\n",
-                      m.jobs.size() - runs.size(), m.jobs.size());
+                      m.jobs.size() - pool.runs.size(), m.jobs.size());
+  return md;
+}
 
-  const std::vector<std::pair<std::string, std::string>> section_errors = {
+// A block of metrics.json with its part of summary.md.
+struct Part {
+  nlohmann::ordered_json json;
+  std::string md;
+};
+
+// River paper Table 1 over the pooled sections of one algorithm.
+Part pooled_section_errors(const Pool& pool, const std::vector<const PooledSection*>& rows) {
+  static const std::vector<std::pair<std::string, std::string>> section_errors = {
       {"p_m_per_m", "ε'_p [m/m]"},           {"x_m_per_m", "ε'_x [m/m]"},
       {"y_m_per_m", "ε'_y [m/m]"},           {"z_m_per_m", "ε'_z [m/m]"},
       {"roll_deg_per_m", "ε'_roll [deg/m]"}, {"pitch_deg_per_m", "ε'_pitch [deg/m]"},
       {"yaw_deg_per_m", "ε'_yaw [deg/m]"}};
-
-  for (const auto& algo : out.algorithms) {
-    nlohmann::ordered_json ja;
-    std::vector<const Section*> rows;
-    for (const auto& s : sections) {
-      const auto it = s.cells.find("algorithm");
-      if (it != s.cells.end() && it->second == algo) rows.push_back(&s);
+  Part p;
+  p.json["count"] = rows.size();
+  p.md = fmt::format("Pooled section errors, {} sections (river paper Table 1):\n\n", rows.size());
+  p.md += "| error | Min | Mean | Median | SD | Max | n |\n|---|---|---|---|---|---|---|\n";
+  for (const auto& [column, label] : section_errors) {
+    std::vector<double> v;
+    for (const PooledSection* s : rows) {
+      const double x = cell_number(pool.value_of(*s, column));
+      if (std::isfinite(x)) v.push_back(x);
     }
-    md += fmt::format("\n## {}\n\n", algo);
-    // Section errors over the pool (river paper Table 1).
-    ja["sections"]["count"] = rows.size();
-    md += fmt::format("Pooled section errors, {} sections (river paper Table 1):\n\n", rows.size());
-    md += "| error | Min | Mean | Median | SD | Max | n |\n|---|---|---|---|---|---|---|\n";
-    for (const auto& [column, label] : section_errors) {
-      std::vector<double> v;
-      for (const Section* s : rows) {
-        const double x = cell_number(value_of(*s, column));
-        if (std::isfinite(x)) v.push_back(x);
-      }
-      const eval::Summary sum = eval::summarize(v);
-      ja["sections"][column] = {{"n", sum.n},
-                                {"min", jnum(v.empty() ? kNaN : sum.min)},
-                                {"mean", jnum(v.empty() ? kNaN : sum.mean)},
-                                {"median", jnum(v.empty() ? kNaN : sum.median)},
-                                {"sd", jnum(v.size() < 2 ? kNaN : sum.sd_sample)},
-                                {"rmse", jnum(v.empty() ? kNaN : sum.rmse)},
-                                {"max", jnum(v.empty() ? kNaN : sum.max)}};
-      auto f = [&](double x, bool ok) { return ok ? fmt::format("{:.4g}", x) : std::string("—"); };
-      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", label, f(sum.min, sum.n > 0),
+    const eval::Summary sum = eval::summarize(v);
+    p.json[column] = {{"n", sum.n},
+                      {"min", jnum(v.empty() ? kNaN : sum.min)},
+                      {"mean", jnum(v.empty() ? kNaN : sum.mean)},
+                      {"median", jnum(v.empty() ? kNaN : sum.median)},
+                      {"sd", jnum(v.size() < 2 ? kNaN : sum.sd_sample)},
+                      {"rmse", jnum(v.empty() ? kNaN : sum.rmse)},
+                      {"max", jnum(v.empty() ? kNaN : sum.max)}};
+    auto f = [&](double x, bool ok) { return ok ? fmt::format("{:.4g}", x) : std::string("—"); };
+    p.md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", label, f(sum.min, sum.n > 0),
                         f(sum.mean, sum.n > 0), f(sum.median, sum.n > 0),
                         f(sum.sd_sample, sum.n > 1), f(sum.max, sum.n > 0), sum.n);
-    }
-
-    // OLS of Eq. (13) on the pool.
-    nlohmann::ordered_json jr;
-    jr["response"] = o.response;
-    jr["covariates"] = covariates;
-    std::vector<std::string> names;
-    for (const auto& c : covariates) {
-      bool any = false;
-      for (const Section* s : rows) any = any || std::isfinite(cell_number(value_of(*s, c)));
-      if (any) {
-        names.push_back(c);
-      } else if (!default_covariates) {
-        names.push_back(c);  // the fit reports it (no values)
-      }
-    }
-    std::vector<double> y;
-    std::vector<std::vector<double>> columns(names.size());
-    std::size_t dropped = 0;
-    for (const Section* s : rows) {
-      std::vector<double> x;
-      bool complete = std::isfinite(cell_number(value_of(*s, o.response)));
-      for (const auto& c : names) {
-        x.push_back(cell_number(value_of(*s, c)));
-        complete = complete && std::isfinite(x.back());
-      }
-      if (!complete) {
-        ++dropped;
-        continue;
-      }
-      y.push_back(cell_number(value_of(*s, o.response)));
-      for (std::size_t k = 0; k < names.size(); ++k) columns[k].push_back(x[k]);
-    }
-    jr["dropped_sections"] = dropped;
-    md += fmt::format(
-        "\nRegression of `{}` on {} over the pool (river paper Eq. (13)):\n\n", o.response,
-        names.empty() ? std::string("nothing") : fmt::format("`{}`", fmt::join(names, "`, `")));
-    std::string skipped;
-    if (names.empty()) {
-      skipped = "no covariate has values in the pooled sections";
-    } else if (y.size() < names.size() + 2) {
-      skipped = fmt::format(
-          "got {} complete sections, need at least {} for {} covariates and an "
-          "intercept",
-          y.size(), names.size() + 2, names.size());
-    } else {
-      try {
-        append_ols(eval::ols(y, columns, names), &jr, &md);
-      } catch (const UserError& e) {
-        skipped = e.what();
-      }
-    }
-    if (!skipped.empty()) {
-      jr["skipped"] = skipped;
-      md += "Not fitted: " + skipped + "\n";
-      out.warnings.push_back(fmt::format("{}: regression not fitted: {}", algo, skipped));
-    }
-    if (dropped)
-      md += fmt::format("\n{} of {} sections lack a value and were left out.\n", dropped,
-                        rows.size());
-    ja["regression"] = jr;
-
-    // Run metrics over all runs.
-    ja["runs"] = nlohmann::ordered_json::object();
-    for (const auto& rm : run_metrics()) {
-      std::vector<double> v;
-      for (const auto& r : runs) v.push_back(run_metric_value(r.metrics, algo, rm));
-      ja["runs"][rm.name] = stat_json(stat_of(v));
-    }
-    if (!o.run_regressions.empty()) {
-      ja["run_regressions"] = nlohmann::ordered_json::object();
-      run_regressions(regressions, runs, algo, &ja["run_regressions"], &md, &out.warnings);
-    }
-    metrics["algorithms"][algo] = ja;
   }
+  return p;
+}
 
-  // -------------------------------------------------------------------------
-  // Per run and per point.
-  std::vector<std::string> run_header = {"job", "point", "replicate", "seed"};
-  for (const auto& a : m.axes) run_header.push_back(a.name);
-  run_header.push_back("algorithm");
-  for (const auto& rm : run_metrics()) run_header.push_back(rm.name);
-  std::string runs_csv = csv_row(run_header);
-  for (const auto& r : runs)
-    for (const auto& algo : out.algorithms) {
+// OLS of the river paper's Eq. (13) on the pooled sections of one algorithm.
+Part pooled_regression(const Pool& pool, const std::vector<const PooledSection*>& rows,
+                       const std::string& response, const Covariates& covariates,
+                       const std::string& algorithm, std::vector<std::string>* warnings) {
+  Part p;
+  p.json["response"] = response;
+  p.json["covariates"] = covariates.names;
+  std::vector<std::string> names;
+  for (const auto& c : covariates.names) {
+    bool any = false;
+    for (const PooledSection* s : rows)
+      any = any || std::isfinite(cell_number(pool.value_of(*s, c)));
+    if (any || !covariates.by_default) names.push_back(c);  // an asked-for one: the fit says
+  }
+  std::vector<double> y;
+  std::vector<std::vector<double>> columns(names.size());
+  std::size_t dropped = 0;
+  for (const PooledSection* s : rows) {
+    std::vector<double> x;
+    bool complete = std::isfinite(cell_number(pool.value_of(*s, response)));
+    for (const auto& c : names) {
+      x.push_back(cell_number(pool.value_of(*s, c)));
+      complete = complete && std::isfinite(x.back());
+    }
+    if (!complete) {
+      ++dropped;
+      continue;
+    }
+    y.push_back(cell_number(pool.value_of(*s, response)));
+    for (std::size_t k = 0; k < names.size(); ++k) columns[k].push_back(x[k]);
+  }
+  p.json["dropped_sections"] = dropped;
+  p.md = fmt::format(
+      "\nRegression of `{}` on {} over the pool (river paper Eq. (13)):\n\n", response,
+      names.empty() ? std::string("nothing") : fmt::format("`{}`", fmt::join(names, "`, `")));
+  std::string skipped;
+  if (names.empty()) {
+    skipped = "no covariate has values in the pooled sections";
+  } else if (y.size() < names.size() + 2) {
+    skipped = fmt::format(
+        "got {} complete sections, need at least {} for {} covariates and an "
+        "intercept",
+        y.size(), names.size() + 2, names.size());
+  } else {
+    try {
+      append_ols(eval::ols(y, columns, names), &p.json, &p.md);
+    } catch (const UserError& e) {
+      skipped = e.what();
+    }
+  }
+  if (!skipped.empty()) {
+    p.json["skipped"] = skipped;
+    p.md += "Not fitted: " + skipped + "\n";
+    warnings->push_back(fmt::format("{}: regression not fitted: {}", algorithm, skipped));
+  }
+  if (dropped)
+    p.md +=
+        fmt::format("\n{} of {} sections lack a value and were left out.\n", dropped, rows.size());
+  return p;
+}
+
+// One algorithm: pooled Table 1, the pooled regression, run metrics and --regress fits.
+Part merge_algorithm(const Pool& pool, const std::string& algo, const MergeOptions& o,
+                     const Covariates& covariates, const std::vector<RunRegression>& regressions,
+                     std::vector<std::string>* warnings) {
+  const std::vector<const PooledSection*> rows = pool.sections_of(algo);
+  Part p;
+  p.md = fmt::format("\n## {}\n\n", algo);
+  Part errors = pooled_section_errors(pool, rows);
+  p.json["sections"] = errors.json;
+  p.md += errors.md;
+  Part fit = pooled_regression(pool, rows, o.response, covariates, algo, warnings);
+  p.md += fit.md;
+  p.json["regression"] = fit.json;
+  p.json["runs"] = nlohmann::ordered_json::object();
+  for (const auto& rm : run_metrics()) {
+    std::vector<double> v;
+    for (const auto& r : pool.runs) v.push_back(run_metric_value(r.metrics, algo, rm));
+    p.json["runs"][rm.name] = stat_json(stat_of(v));
+  }
+  if (!o.run_regressions.empty()) {
+    p.json["run_regressions"] = nlohmann::ordered_json::object();
+    run_regressions(regressions, pool.runs, algo, &p.json["run_regressions"], &p.md, warnings);
+  }
+  return p;
+}
+
+// runs.csv: every run metric of every run and algorithm.
+std::string runs_csv(const SweepManifest& m, const Pool& pool) {
+  std::vector<std::string> header = {"job", "point", "replicate", "seed"};
+  for (const auto& a : m.axes) header.push_back(a.name);
+  header.push_back("algorithm");
+  for (const auto& rm : run_metrics()) header.push_back(rm.name);
+  std::string csv = csv_row(header);
+  for (const auto& r : pool.runs)
+    for (const auto& algo : pool.algorithms) {
       std::vector<std::string> row = {r.job->id, std::to_string(r.job->point),
                                       std::to_string(r.job->replicate),
                                       std::to_string(r.job->seed)};
@@ -617,199 +528,261 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
       row.push_back(algo);
       for (const auto& rm : run_metrics())
         row.push_back(num(run_metric_value(r.metrics, algo, rm)));
-      runs_csv += csv_row(row);
+      csv += csv_row(row);
     }
+  return csv;
+}
 
-  std::vector<std::string> point_header = {"point"};
-  for (const auto& a : m.axes) point_header.push_back(a.name);
-  point_header.push_back("algorithm");
-  point_header.push_back("runs");
-  for (const auto& rm : run_metrics())
-    for (const char* suffix : {"_mean", "_sd", "_ci95_low", "_ci95_high"})
-      point_header.push_back(std::string(rm.name) + suffix);
-  std::string points_csv = csv_row(point_header);
-  std::map<std::size_t, std::vector<const RunData*>> by_point;  // ordered by point index
-  for (const auto& r : runs) by_point[r.job->point].push_back(&r);
-  metrics["points"] = nlohmann::ordered_json::object();
-  // The table shows the first run metric the runs have (sections, else the APE, else ...).
+// The run metric the points table shows: the first one the runs have (sections, else APE...).
+std::string main_run_metric(const Pool& pool) {
   std::string main_metric = run_metrics().front().name;
   for (auto it = run_metrics().rbegin(); it != run_metrics().rend(); ++it)
-    for (const auto& r : runs)
-      for (const auto& algo : out.algorithms)
+    for (const auto& r : pool.runs)
+      for (const auto& algo : pool.algorithms)
         if (std::isfinite(run_metric_value(r.metrics, algo, *it))) main_metric = it->name;
-  md +=
+  return main_metric;
+}
+
+// points.csv, metrics.json `points` and the summary's points table: each run metric per point,
+// mean over replicates with its 95 % interval.
+struct Points {
+  std::string csv, md;
+  nlohmann::ordered_json json = nlohmann::ordered_json::object();
+};
+
+Points per_point(const SweepManifest& m, const Pool& pool) {
+  std::vector<std::string> header = {"point"};
+  for (const auto& a : m.axes) header.push_back(a.name);
+  header.push_back("algorithm");
+  header.push_back("runs");
+  for (const auto& rm : run_metrics())
+    for (const char* suffix : {"_mean", "_sd", "_ci95_low", "_ci95_high"})
+      header.push_back(std::string(rm.name) + suffix);
+  Points out;
+  out.csv = csv_row(header);
+  std::map<std::size_t, std::vector<const RunData*>> by_point;  // ordered by point index
+  for (const auto& r : pool.runs) by_point[r.job->point].push_back(&r);
+  const std::string main_metric = main_run_metric(pool);
+  out.md =
       fmt::format("\n## Points\n\n`{}` per point, mean over replicates [95% CI]:\n\n", main_metric);
-  md += "| point |";
-  for (const auto& a : m.axes) md += " " + a.name + " |";
-  for (const auto& algo : out.algorithms) md += " " + algo + " |";
-  md += "\n|---|";
-  for (std::size_t k = 0; k < m.axes.size() + out.algorithms.size(); ++k) md += "---|";
-  md += "\n";
+  out.md += "| point |";
+  for (const auto& a : m.axes) out.md += " " + a.name + " |";
+  for (const auto& algo : pool.algorithms) out.md += " " + algo + " |";
+  out.md += "\n|---|";
+  for (std::size_t k = 0; k < m.axes.size() + pool.algorithms.size(); ++k) out.md += "---|";
+  out.md += "\n";
   for (const auto& [point, point_runs] : by_point) {
     const std::string pid = fmt::format("p{:04}", point);
+    const auto& params = point_runs.front()->job->params;
     nlohmann::ordered_json jp;
     jp["params"] = nlohmann::ordered_json::object();
-    for (const auto& [name, value] : point_runs.front()->job->params)
-      jp["params"][name] = yaml_text_to_json(value);
+    for (const auto& [name, value] : params) jp["params"][name] = yaml_text_to_json(value);
     jp["runs"] = point_runs.size();
-    md += "| " + pid + " |";
-    for (const auto& [name, value] : point_runs.front()->job->params) md += " " + value + " |";
-    for (const auto& algo : out.algorithms) {
+    out.md += "| " + pid + " |";
+    for (const auto& [name, value] : params) out.md += " " + value + " |";
+    for (const auto& algo : pool.algorithms) {
       std::vector<std::string> row = {std::to_string(point)};
-      for (const auto& [name, value] : point_runs.front()->job->params) row.push_back(value);
+      for (const auto& [name, value] : params) row.push_back(value);
       row.push_back(algo);
       row.push_back(std::to_string(point_runs.size()));
       for (const auto& rm : run_metrics()) {
         std::vector<double> v;
         for (const RunData* r : point_runs) v.push_back(run_metric_value(r->metrics, algo, rm));
         const Stat s = stat_of(v);
-        row.push_back(num(s.mean));
-        row.push_back(num(s.sd));
-        row.push_back(num(s.lo));
-        row.push_back(num(s.hi));
+        for (double x : {s.mean, s.sd, s.lo, s.hi}) row.push_back(num(x));
         jp["algorithms"][algo][rm.name] = stat_json(s);
         if (rm.name == main_metric)
-          md += s.n == 0   ? " — |"
-                : s.n == 1 ? fmt::format(" {:.4g} |", s.mean)
-                           : fmt::format(" {:.4g} [{:.4g}, {:.4g}] |", s.mean, s.lo, s.hi);
+          out.md += s.n == 0   ? " — |"
+                    : s.n == 1 ? fmt::format(" {:.4g} |", s.mean)
+                               : fmt::format(" {:.4g} [{:.4g}, {:.4g}] |", s.mean, s.lo, s.hi);
       }
-      points_csv += csv_row(row);
+      out.csv += csv_row(row);
     }
-    md += "\n";
-    metrics["points"][pid] = jp;
+    out.md += "\n";
+    out.json[pid] = jp;
   }
+  return out;
+}
 
+// gnuplot and its PNG terminal (pngcairo, else libgd's png), or nullopt with a warning.
+std::optional<std::pair<fs::path, std::string>> find_gnuplot(const MergeOptions& o,
+                                                             std::vector<std::string>* warnings) {
+  const std::optional<fs::path> gnuplot =
+      o.gnuplot.empty() ? find_on_path("gnuplot") : std::optional<fs::path>(o.gnuplot);
+  if (!gnuplot) {
+    warnings->push_back("gnuplot not found on PATH: plots skipped (install gnuplot-nox)");
+    return std::nullopt;
+  }
+  ProcessSpec probe{*gnuplot, {"-e", "set terminal pngcairo"}, "/dev/null", {}, true};
+  try {
+    return std::make_pair(*gnuplot, wait_process(spawn_process(probe)).ok() ? "pngcairo" : "png");
+  } catch (const UserError& e) {
+    warnings->push_back(std::string("gnuplot cannot run: plots skipped: ") + e.what());
+    return std::nullopt;
+  }
+}
+
+// An axis's values in order: numeric ascending, else first appearance.
+std::vector<std::string> axis_values(const AxisInfo& a, const Pool& pool) {
+  std::vector<std::string> values;
+  for (const auto& r : pool.runs)
+    for (const auto& [name, value] : r.job->params)
+      if (name == a.name && std::find(values.begin(), values.end(), value) == values.end())
+        values.push_back(value);
+  if (a.numeric)
+    std::stable_sort(values.begin(), values.end(), [](const std::string& x, const std::string& y) {
+      return cell_number(x) < cell_number(y);
+    });
+  return values;
+}
+
+// One plot's data: per algorithm a block of (x, mean, ci95 low, high, runs, label) over the
+// axis values (other axes and replicates pooled); the algorithms that have a block.
+std::pair<std::string, std::vector<std::pair<std::size_t, std::string>>> plot_data(
+    const AxisInfo& a, const std::vector<std::string>& values, const RunMetric& rm,
+    const Pool& pool) {
+  std::string dat = fmt::format(
+      "# {} vs {}: x, mean, ci95_low, ci95_high, runs, label; one "
+      "block per algorithm\n",
+      rm.name, a.name);
+  std::vector<std::pair<std::size_t, std::string>> series;  // block index, algorithm
+  std::size_t block = 0;
+  for (const auto& algo : pool.algorithms) {
+    std::string rows;
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      std::vector<double> v;
+      for (const auto& r : pool.runs)
+        for (const auto& [name, value] : r.job->params)
+          if (name == a.name && value == values[k])
+            v.push_back(run_metric_value(r.metrics, algo, rm));
+      const Stat s = stat_of(v);
+      if (s.n == 0) continue;
+      std::string label = values[k];
+      std::replace(label.begin(), label.end(), '"', '\'');
+      rows += fmt::format("{} {} {} {} {} \"{}\"\n",
+                          a.numeric ? num(cell_number(values[k])) : std::to_string(k), num(s.mean),
+                          num(s.n >= 2 ? s.lo : s.mean), num(s.n >= 2 ? s.hi : s.mean), s.n, label);
+    }
+    if (rows.empty()) continue;
+    dat += fmt::format("# {}\n{}\n\n", algo, rows);
+    series.emplace_back(block++, algo);
+  }
+  return {dat, series};
+}
+
+// The gnuplot script of one plot: series side by side (dodged by a little of the x range) so
+// that their bars do not hide one another.
+std::string plot_script(const AxisInfo& a, const std::vector<std::string>& values,
+                        const RunMetric& rm, const std::string& stem, const std::string& terminal,
+                        const std::vector<std::pair<std::size_t, std::string>>& series) {
+  bool log_x = a.spec == "logspace";
+  for (const auto& v : values) log_x = log_x && a.numeric && cell_number(v) > 0;
+  std::string gp = fmt::format(
+      "# Regenerate with: gnuplot {stem}.gp (in this folder)\n"
+      "set terminal {term} size 900,560 noenhanced\n"
+      "set output '{stem}.png'\n"
+      "set title \"{metric} vs {axis} (mean over runs, 95% CI)\"\n"
+      "set xlabel \"{key}\"\nset ylabel \"{label}\"\n"
+      "set grid\nset key outside right top\nset offsets graph 0.05, graph 0.05, 0, 0\n"
+      "{logx}{xtics}"
+      "plot ",
+      fmt::arg("stem", stem), fmt::arg("term", terminal), fmt::arg("metric", rm.name),
+      fmt::arg("axis", a.name), fmt::arg("key", a.key), fmt::arg("label", rm.label),
+      fmt::arg("logx", log_x ? "set logscale x\n" : ""),
+      fmt::arg("xtics", a.numeric ? "" : "set xtics rotate by -30\n"));
+  double lo = 0, hi = 1;
+  if (a.numeric && !values.empty()) {
+    lo = cell_number(values.front());
+    hi = cell_number(values.back());
+  } else {
+    hi = static_cast<double>(values.size());
+  }
+  const double span = hi > lo ? hi - lo : 1.0;
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    const double shift = (static_cast<double>(k) - (static_cast<double>(series.size()) - 1) / 2);
+    const std::string x = !a.numeric ? fmt::format("($1{:+g})", 0.08 * shift)
+                          : log_x    ? fmt::format("($1*{:g})", std::pow(hi / lo, 0.012 * shift))
+                                     : fmt::format("($1{:+g})", 0.012 * span * shift);
+    gp += fmt::format("{}'{}.dat' index {} using {}:2:3:4{} with yerrorlines title '{}'",
+                      k ? ", \\\n     " : "", stem, series[k].first, x, a.numeric ? "" : ":xtic(6)",
+                      series[k].second);
+  }
+  return gp + "\n";
+}
+
+// Plots: for every axis and run metric the runs have, the marginal mean over all runs at each
+// axis value, with its 95% CI. Returns the summary's image lines.
+std::vector<std::string> draw_plots(const SweepManifest& m, const Pool& pool,
+                                    const std::pair<fs::path, std::string>& gnuplot,
+                                    const fs::path& plots, MergeSummary* out) {
+  std::vector<std::string> plot_md;
+  fs::create_directories(plots);
+  for (const auto& a : m.axes) {
+    const std::vector<std::string> values = axis_values(a, pool);
+    for (const RunMetric& rm : run_metrics()) {
+      const std::string stem = file_safe(a.name) + "__" + rm.name;
+      const auto [dat, series] = plot_data(a, values, rm, pool);
+      if (series.empty()) continue;  // a metric the runs do not have
+      write_file_atomic(plots / (stem + ".dat"), dat);
+      write_file_atomic(plots / (stem + ".gp"),
+                        plot_script(a, values, rm, stem, gnuplot.second, series));
+      const fs::path log = plots / (stem + ".log");
+      ProcessSpec spec{gnuplot.first, {stem + ".gp"}, log, plots, true};
+      const ExitStatus st = wait_process(spawn_process(spec));
+      std::error_code ec;
+      if (st.ok() && fs::exists(plots / (stem + ".png"), ec)) {
+        fs::remove(log, ec);
+        out->plots.push_back("plots/" + stem + ".png");
+        plot_md.push_back(fmt::format("![{} vs {}](plots/{}.png)", rm.name, a.name, stem));
+      } else {
+        out->warnings.push_back(
+            fmt::format("gnuplot failed on plots/{}.gp ({}); see "
+                        "summary/plots/{}.log",
+                        stem, st.describe(), stem));
+      }
+    }
+  }
+  return plot_md;
+}
+
+}  // namespace
+
+MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
+  MergeSummary out;
+  out.dir = m.dir / "summary";
+  const std::vector<RunRegression> regressions = parse_run_regressions(o.run_regressions, m);
+  const SweepStatus status = sweep_status(m);
+  require_done_jobs(m, status, o.allow_missing);
+  const Pool pool = gather_runs(m, status);
+  out.runs = pool.runs.size();
+  out.sections = pool.sections.size();
+  out.algorithms = pool.algorithms;
+  const Covariates covariates = pooled_covariates(m, o, pool, &out.warnings);
+
+  nlohmann::ordered_json metrics;
+  metrics["sweep"] = sweep_info_json(m, pool);
+  metrics["algorithms"] = nlohmann::ordered_json::object();
+  std::string md = summary_head_md(m, pool);
+  for (const auto& algo : pool.algorithms) {
+    Part p = merge_algorithm(pool, algo, o, covariates, regressions, &out.warnings);
+    md += p.md;
+    metrics["algorithms"][algo] = std::move(p.json);
+  }
+  const Points points = per_point(m, pool);
+  metrics["points"] = points.json;
+  md += points.md;
   // Plot warnings depend on the machine (is gnuplot installed?), not on the runs.
   metrics["warnings"] = out.warnings;
 
-  // -------------------------------------------------------------------------
   // Write (aside, then rename into place), plots included.
   AtomicDirectory dir(out.dir, /*replace=*/true);
-  write_file_atomic(dir.path() / "sections.csv", pooled_csv);
-  write_file_atomic(dir.path() / "runs.csv", runs_csv);
-  write_file_atomic(dir.path() / "points.csv", points_csv);
-
-  // Plots: for every axis and the first metrics, the marginal mean over all
-  // runs at each axis value (other axes and replicates pooled), with its 95% CI.
+  write_file_atomic(dir.path() / "sections.csv", pooled_sections_csv(pool));
+  write_file_atomic(dir.path() / "runs.csv", runs_csv(m, pool));
+  write_file_atomic(dir.path() / "points.csv", points.csv);
   std::vector<std::string> plot_md;
-  std::optional<fs::path> gnuplot;
-  std::string terminal;
-  if (o.plots && !out.algorithms.empty()) {
-    gnuplot = o.gnuplot.empty() ? find_on_path("gnuplot") : std::optional<fs::path>(o.gnuplot);
-    if (!gnuplot) {
-      out.warnings.push_back("gnuplot not found on PATH: plots skipped (install gnuplot-nox)");
-    } else {
-      // pngcairo draws nicer; the libgd `png` terminal is the fallback.
-      ProcessSpec probe{*gnuplot, {"-e", "set terminal pngcairo"}, "/dev/null", {}, true};
-      try {
-        terminal = wait_process(spawn_process(probe)).ok() ? "pngcairo" : "png";
-      } catch (const UserError& e) {
-        out.warnings.push_back(std::string("gnuplot cannot run: plots skipped: ") + e.what());
-        gnuplot.reset();
-      }
-    }
-  }
-  if (gnuplot) {
-    const fs::path plots = dir.path() / "plots";
-    fs::create_directories(plots);
-    for (const auto& a : m.axes) {
-      // Axis values in order: numeric ascending, else first appearance.
-      std::vector<std::string> values;
-      for (const auto& r : runs)
-        for (const auto& [name, value] : r.job->params)
-          if (name == a.name && std::find(values.begin(), values.end(), value) == values.end())
-            values.push_back(value);
-      if (a.numeric)
-        std::stable_sort(values.begin(), values.end(),
-                         [](const std::string& x, const std::string& y) {
-                           return cell_number(x) < cell_number(y);
-                         });
-      bool log_x = a.spec == "logspace";
-      for (const auto& v : values) log_x = log_x && a.numeric && cell_number(v) > 0;
-      for (std::size_t mi = 0; mi < run_metrics().size(); ++mi) {  // those the runs have
-        const RunMetric& rm = run_metrics()[mi];
-        const std::string stem = file_safe(a.name) + "__" + rm.name;
-        std::string dat = fmt::format(
-            "# {} vs {}: x, mean, ci95_low, ci95_high, runs, label; one "
-            "block per algorithm\n",
-            rm.name, a.name);
-        std::vector<std::pair<std::size_t, std::string>> series;  // block index, algorithm
-        std::size_t block = 0;
-        for (const auto& algo : out.algorithms) {
-          std::string rows;
-          for (std::size_t k = 0; k < values.size(); ++k) {
-            std::vector<double> v;
-            for (const auto& r : runs)
-              for (const auto& [name, value] : r.job->params)
-                if (name == a.name && value == values[k])
-                  v.push_back(run_metric_value(r.metrics, algo, rm));
-            const Stat s = stat_of(v);
-            if (s.n == 0) continue;
-            std::string label = values[k];
-            std::replace(label.begin(), label.end(), '"', '\'');
-            rows += fmt::format("{} {} {} {} {} \"{}\"\n",
-                                a.numeric ? num(cell_number(values[k])) : std::to_string(k),
-                                num(s.mean), num(s.n >= 2 ? s.lo : s.mean),
-                                num(s.n >= 2 ? s.hi : s.mean), s.n, label);
-          }
-          if (rows.empty()) continue;
-          dat += fmt::format("# {}\n{}\n\n", algo, rows);
-          series.emplace_back(block++, algo);
-        }
-        if (series.empty()) continue;
-        std::string gp = fmt::format(
-            "# Regenerate with: gnuplot {stem}.gp (in this folder)\n"
-            "set terminal {term} size 900,560 noenhanced\n"
-            "set output '{stem}.png'\n"
-            "set title \"{metric} vs {axis} (mean over runs, 95% CI)\"\n"
-            "set xlabel \"{key}\"\nset ylabel \"{label}\"\n"
-            "set grid\nset key outside right top\nset offsets graph 0.05, graph 0.05, 0, 0\n"
-            "{logx}{xtics}"
-            "plot ",
-            fmt::arg("stem", stem), fmt::arg("term", terminal), fmt::arg("metric", rm.name),
-            fmt::arg("axis", a.name), fmt::arg("key", a.key), fmt::arg("label", rm.label),
-            fmt::arg("logx", log_x ? "set logscale x\n" : ""),
-            fmt::arg("xtics", a.numeric ? "" : "set xtics rotate by -30\n"));
-        // Series side by side (dodged by a little of the x range) so that their bars do not hide
-        // one another.
-        double lo = 0, hi = 1;
-        if (a.numeric && !values.empty()) {
-          lo = cell_number(values.front());
-          hi = cell_number(values.back());
-        } else {
-          hi = static_cast<double>(values.size());
-        }
-        const double span = hi > lo ? hi - lo : 1.0;
-        for (std::size_t k = 0; k < series.size(); ++k) {
-          const double shift =
-              (static_cast<double>(k) - (static_cast<double>(series.size()) - 1) / 2);
-          const std::string x = !a.numeric ? fmt::format("($1{:+g})", 0.08 * shift)
-                                : log_x ? fmt::format("($1*{:g})", std::pow(hi / lo, 0.012 * shift))
-                                        : fmt::format("($1{:+g})", 0.012 * span * shift);
-          gp += fmt::format("{}'{}.dat' index {} using {}:2:3:4{} with yerrorlines title '{}'",
-                            k ? ", \\\n     " : "", stem, series[k].first, x,
-                            a.numeric ? "" : ":xtic(6)", series[k].second);
-        }
-        gp += "\n";
-        write_file_atomic(plots / (stem + ".dat"), dat);
-        write_file_atomic(plots / (stem + ".gp"), gp);
-        const fs::path log = plots / (stem + ".log");
-        ProcessSpec spec{*gnuplot, {stem + ".gp"}, log, plots, true};
-        const ExitStatus st = wait_process(spawn_process(spec));
-        std::error_code ec;
-        if (st.ok() && fs::exists(plots / (stem + ".png"), ec)) {
-          fs::remove(log, ec);
-          out.plots.push_back("plots/" + stem + ".png");
-          plot_md.push_back(fmt::format("![{} vs {}](plots/{}.png)", rm.name, a.name, stem));
-        } else {
-          out.warnings.push_back(
-              fmt::format("gnuplot failed on plots/{}.gp ({}); see "
-                          "summary/plots/{}.log",
-                          stem, st.describe(), stem));
-        }
-      }
-    }
-  }
+  if (o.plots && !pool.algorithms.empty())
+    if (const auto gnuplot = find_gnuplot(o, &out.warnings))
+      plot_md = draw_plots(m, pool, *gnuplot, dir.path() / "plots", &out);
   if (!plot_md.empty()) {
     md += "\n## Plots\n\n";
     for (const auto& p : plot_md) md += p + "\n\n";

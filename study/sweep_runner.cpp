@@ -152,6 +152,39 @@ class FileLock {
   int fd_ = -1;
 };
 
+// A job the local runner started.
+struct RunningJob {
+  pid_t pid;
+  const SweepJob* job;
+  Clock::time_point start;
+  int signals_sent = 0;  // past the timeout: 1 after SIGTERM, 2 after SIGKILL
+};
+
+// failed/ID.json for a job that ended without its completion marker; returns what happened.
+// A record that cannot be written (a full disk) leaves the job `missing`, to run again.
+std::string record_failure(const SweepManifest& m, const RunningJob& r, const ExitStatus& status,
+                           const SweepRunOptions& options) {
+  std::error_code log_ec;
+  const std::string log = fs::exists(m.log_file(r.job->id), log_ec)
+                              ? read_text_file(m.log_file(r.job->id), "job log")
+                              : std::string();
+  std::string why = r.signals_sent > 0 ? fmt::format(
+                                             "timeout: still running after --job-timeout {} s, "
+                                             "stopped ({})",
+                                             options.job_timeout_s, status.describe())
+                    : status.ok() ? "exit code 0 but no completion marker"
+                                  : status.describe();
+  if (options.local && r.signals_sent > 0) leftover_temporaries(m, /*remove=*/true);
+  try {
+    const std::string log_tail = tail_of(log);
+    write_failure(m, *r.job, why, job_error(m, *r.job, log_tail), log_tail);
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    why += fmt::format(" (and no failure record: {})", what.substr(0, what.find('\n')));
+  }
+  return why;
+}
+
 }  // namespace
 
 std::string JobRunResult::brief() const {
@@ -273,13 +306,7 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
   }
   fs::create_directories(m.dir / "logs");
 
-  struct Running {
-    pid_t pid;
-    const SweepJob* job;
-    Clock::time_point start;
-    int signals_sent = 0;  // past the timeout: 1 after SIGTERM, 2 after SIGKILL
-  };
-  std::vector<Running> running;
+  std::vector<RunningJob> running;
   SweepProgress progress;
   progress.total = pending.size();
   progress.skipped = summary.skipped;
@@ -316,7 +343,7 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
           continue;
         }
         any = true;
-        const Running r = running[i];
+        const RunningJob r = running[i];
         running.erase(running.begin() + static_cast<std::ptrdiff_t>(i));
         ++summary.ran;
         ++progress.finished;
@@ -330,26 +357,7 @@ SweepRunSummary run_sweep_jobs(const SweepManifest& m, const SweepRunOptions& op
           ++summary.failed;
           ++progress.failed;
           summary.failed_ids.push_back(r.job->id);
-          std::error_code log_ec;
-          const std::string log = fs::exists(m.log_file(r.job->id), log_ec)
-                                      ? read_text_file(m.log_file(r.job->id), "job log")
-                                      : std::string();
-          std::string why = r.signals_sent > 0
-                                ? fmt::format(
-                                      "timeout: still running after --job-timeout {} s, "
-                                      "stopped ({})",
-                                      options.job_timeout_s, status->describe())
-                            : status->ok() ? "exit code 0 but no completion marker"
-                                           : status->describe();
-          if (options.local && r.signals_sent > 0) leftover_temporaries(m, /*remove=*/true);
-          try {
-            const std::string log_tail = tail_of(log);
-            write_failure(m, *r.job, why, job_error(m, *r.job, log_tail), log_tail);
-          } catch (const std::exception& e) {
-            // A full disk: the job stays `missing` and runs again; the others go on.
-            const std::string what = e.what();
-            why += fmt::format(" (and no failure record: {})", what.substr(0, what.find('\n')));
-          }
+          const std::string why = record_failure(m, r, *status, options);
           progress.last_detail = why;
         }
         // The next job starts before the report, so that "running" counts it.

@@ -1,0 +1,143 @@
+#include "study/run_regressions.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include "core/error.hpp"
+#include "study/sweep_merge.hpp"
+
+namespace driftlab::study {
+
+namespace {
+
+nlohmann::ordered_json jnum(double v) {
+  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
+}
+
+// The value of a --regress metric in one run: a run metric by name, else a key path.
+double regression_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
+                               const std::string& metric) {
+  for (const auto& rm : run_metrics())
+    if (rm.name == metric) return run_metric_value(metrics, algorithm, rm);
+  return json_number(metrics, "algorithms." + algorithm + "." + metric);
+}
+
+}  // namespace
+
+// A number at a dotted key path of a JSON document, NaN when absent or not a number.
+double json_number(const nlohmann::json& j, const std::string& dotted) {
+  const nlohmann::json* node = &j;
+  std::size_t start = 0;
+  while (start <= dotted.size()) {
+    const auto dot = dotted.find('.', start);
+    const std::string key = dotted.substr(start, dot == std::string::npos ? dot : dot - start);
+    if (!node->is_object() || !node->contains(key)) return std::numeric_limits<double>::quiet_NaN();
+    node = &(*node)[key];
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
+  return node->is_number() ? node->get<double>() : std::numeric_limits<double>::quiet_NaN();
+}
+
+// An OLS fit into metrics.json (n, R^2, F, each coefficient) and summary.md (a table and
+// the fit's paragraph).
+void append_ols(const eval::OlsResult& r, nlohmann::ordered_json* j, std::string* md) {
+  (*j)["n"] = r.n;
+  (*j)["r2"] = jnum(r.r2);
+  (*j)["adj_r2"] = jnum(r.adj_r2);
+  (*j)["f"] = jnum(r.f);
+  (*j)["f_p"] = jnum(r.f_p);
+  (*j)["sigma"] = jnum(r.sigma);
+  (*j)["coefficients"] = nlohmann::ordered_json::object();
+  *md += "| term | estimate | std. error | t | p | VIF |\n|---|---|---|---|---|---|\n";
+  for (const auto& c : r.coefficients) {
+    (*j)["coefficients"][c.name] = {{"estimate", jnum(c.estimate)},
+                                    {"std_error", jnum(c.std_error)},
+                                    {"t", jnum(c.t)},
+                                    {"p", jnum(c.p)},
+                                    {"vif", jnum(c.vif)},
+                                    {"significant", c.significant}};
+    *md += fmt::format("| {}{} | {:.4g} | {:.3g} | {:.3g} | {:.3g} | {} |\n", c.name,
+                       c.significant ? " *" : "", c.estimate, c.std_error, c.t, c.p,
+                       c.name == "Intercept" ? std::string("") : fmt::format("{:.3g}", c.vif));
+  }
+  (*j)["warnings"] = r.warnings;
+  *md += "\n" + r.brief() + "\n";
+}
+
+std::vector<RunRegression> parse_run_regressions(const std::vector<std::string>& specs,
+                                                 const SweepManifest& m) {
+  std::vector<RunRegression> out;
+  for (const auto& spec : specs) {
+    RunRegression r{spec, "", {}};
+    const auto tilde = spec.find('~');
+    if (tilde == std::string::npos || tilde == 0 || tilde + 1 == spec.size())
+      throw UserError(
+          fmt::format("--regress: got '{}', expected METRIC~AXIS[+AXIS...], e.g. "
+                      "basin_north_rmse_m~amplitude_m",
+                      spec));
+    r.metric = spec.substr(0, tilde);
+    std::string rest = spec.substr(tilde + 1);
+    for (std::size_t start = 0; start <= rest.size();) {
+      const auto plus = rest.find('+', start);
+      r.axes.push_back(rest.substr(start, plus == std::string::npos ? plus : plus - start));
+      if (plus == std::string::npos) break;
+      start = plus + 1;
+    }
+    for (const auto& a : r.axes) {
+      bool known = false;
+      std::string names;
+      for (const auto& ax : m.axes) {
+        known = known || (ax.name == a && ax.numeric);
+        if (ax.numeric) names += (names.empty() ? "" : ", ") + ax.name;
+      }
+      if (!known)
+        throw UserError(
+            fmt::format("--regress '{}': got axis '{}', expected a numeric axis of the sweep: {}",
+                        spec, a, names));
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
+// Fits each --regress over the runs of `algorithm` into j and md.
+void run_regressions(const std::vector<RunRegression>& specs, const std::vector<RunData>& runs,
+                     const std::string& algorithm, nlohmann::ordered_json* j, std::string* md,
+                     std::vector<std::string>* warnings) {
+  for (const auto& spec : specs) {
+    std::vector<double> y;
+    std::vector<std::vector<double>> columns(spec.axes.size());
+    for (const auto& r : runs) {
+      const double v = regression_metric_value(r.metrics, algorithm, spec.metric);
+      std::vector<double> x;
+      for (const auto& axis : spec.axes)
+        for (const auto& [name, value] : r.job->params)
+          if (name == axis) x.push_back(std::strtod(value.c_str(), nullptr));
+      if (!std::isfinite(v) || x.size() != spec.axes.size()) continue;
+      y.push_back(v);
+      for (std::size_t k = 0; k < x.size(); ++k) columns[k].push_back(x[k]);
+    }
+    nlohmann::ordered_json jr;
+    *md += fmt::format("\nRegression of `{}` on `{}` over the runs:\n\n", spec.metric,
+                       fmt::join(spec.axes, "`, `"));
+    try {
+      if (y.size() < spec.axes.size() + 2)
+        throw UserError(fmt::format("got {} runs with a value, need at least {}", y.size(),
+                                    spec.axes.size() + 2));
+      append_ols(eval::ols(y, columns, spec.axes), &jr, md);
+    } catch (const UserError& e) {
+      jr["skipped"] = e.what();
+      *md += std::string("Not fitted: ") + e.what() + "\n";
+      warnings->push_back(
+          fmt::format("{}: --regress {} not fitted: {}", algorithm, spec.text, e.what()));
+    }
+    (*j)[spec.text] = jr;
+  }
+}
+
+}  // namespace driftlab::study
