@@ -424,6 +424,87 @@ double durbin_watson(const std::vector<double>& residuals) {
   return c.statistic;
 }
 
+namespace {
+
+// The residual checks of the fit (on the scale-free residuals: every check is invariant to the
+// scale of y; all-zero residuals, a perfect fit, leave each one unavailable) and the warnings
+// they and the design give.
+void add_residual_checks(const VectorXd& e_s, const std::vector<std::vector<double>>& columns,
+                         const std::vector<std::string>& names, const VectorXd& vif, Index worst,
+                         double condition, bool perfect, const OlsOptions& options,
+                         OlsResult* res) {
+  const Index n = e_s.size(), k = vif.size();
+  const double negligible_scaled = std::sqrt(kPerfectFitRss);
+  OlsDiagnostics& d = res->diagnostics;
+  d.max_vif = vif(worst);
+  d.condition_number = condition;
+  const Check jb = jarque_bera_check(e_s);
+  d.jarque_bera = jb.statistic;
+  d.jarque_bera_p = jb.p;
+  d.jarque_bera_available = jb.available;
+  const Check sw = shapiro_wilk_check(std::vector<double>(e_s.data(), e_s.data() + n));
+  d.shapiro_wilk_w = sw.statistic;
+  d.shapiro_wilk_p = sw.p;
+  d.shapiro_wilk_available = sw.available;
+  const Check bp = breusch_pagan_check(e_s, columns);
+  d.breusch_pagan_lm = bp.statistic;
+  d.breusch_pagan_p = bp.p;
+  d.breusch_pagan_available = bp.available;
+  const Check dw = durbin_watson_check(e_s);
+  d.durbin_watson = dw.available ? dw.statistic : 2.0;
+  d.durbin_watson_available = dw.available;
+
+  auto& warn = res->warnings;
+  const double alpha = options.alpha;
+  if (perfect)
+    warn.push_back(
+        fmt::format("perfect fit (residuals within {:.0e} of the response's spread): "
+                    "reported as exact, so sigma and the standard errors are 0, t and "
+                    "F are infinite, and the residual checks are unavailable",
+                    negligible_scaled));
+  if (jb.available && jb.p < alpha)
+    warn.push_back(fmt::format("residuals look non-normal: Jarque-Bera {} (p {} < alpha {})",
+                               g4(jb.statistic), p_text(jb.p), alpha));
+  if (sw.available && sw.p < alpha)
+    warn.push_back(fmt::format("residuals look non-normal: Shapiro-Wilk W {} (p {} < alpha {})",
+                               g4(sw.statistic), p_text(sw.p), alpha));
+  if (res->n < kShapiroWilkMinN || res->n > kShapiroWilkMaxN)
+    warn.push_back(fmt::format("Shapiro-Wilk not computed: n = {} is outside [{}, {}]", n,
+                               kShapiroWilkMinN, kShapiroWilkMaxN));
+  if (bp.available && bp.p < alpha)
+    warn.push_back(fmt::format(
+        "residuals look heteroscedastic: Breusch-Pagan (Koenker) LM {} (p {} < alpha {}); the "
+        "estimates stay unbiased but the t and F p values are not exact",
+        g4(bp.statistic), p_text(bp.p), alpha));
+  // No exact DW bounds for arbitrary designs; far from 2 is a clear sign on its own.
+  if (dw.available && (dw.statistic < 1.0 || dw.statistic > 3.0))
+    warn.push_back(
+        fmt::format("residuals look serially correlated: Durbin-Watson {} (outside "
+                    "[1, 3]; 2 means uncorrelated)",
+                    g4(dw.statistic)));
+  for (Index j = 0; j < k; ++j)
+    if (vif(j) > kVifWarning)
+      warn.push_back(fmt::format("multicollinearity: VIF of '{}' is {} (> {})",
+                                 names[static_cast<std::size_t>(j)], g4(vif(j)), kVifWarning));
+}
+
+// Data near the limits of double (|values| ~1e154 and up) can still overflow the unscaled
+// sums of squares; say so rather than hand back infinities or NaN.
+void require_finite(const OlsResult& res) {
+  bool finite = std::isfinite(res.rss) && std::isfinite(res.tss) && std::isfinite(res.sigma) &&
+                std::isfinite(res.r2) && std::isfinite(res.adj_r2) && !std::isnan(res.f);
+  for (const auto& c : res.coefficients)
+    finite = finite && std::isfinite(c.estimate) && std::isfinite(c.std_error) && !std::isnan(c.t);
+  for (std::size_t i = 0; i < res.residuals.size(); ++i)
+    finite = finite && std::isfinite(res.residuals[i]) && std::isfinite(res.fitted[i]);
+  if (!finite)
+    throw UserError(
+        "ols: the data are too large in magnitude for double-precision sums of "
+        "squares; rescale y or the columns (e.g. change units)");
+}
+
+}  // namespace
+
 OlsResult ols(const std::vector<double>& y, const std::vector<std::vector<double>>& columns,
               const std::vector<std::string>& names, const OlsOptions& options) {
   check_inputs(y, columns, names, options);
@@ -567,72 +648,8 @@ OlsResult ols(const std::vector<double>& y, const std::vector<std::vector<double
     res.fitted[ui] = y[ui] - res.residuals[ui];
   }
 
-  // Diagnostics on the scale-free residuals: every check is invariant to the scale of y.
-  // All-zero residuals (a perfect fit) leave every check unavailable.
-  OlsDiagnostics& d = res.diagnostics;
-  d.max_vif = vif(worst);
-  d.condition_number = condition;
-  const Check jb = jarque_bera_check(e_s);
-  d.jarque_bera = jb.statistic;
-  d.jarque_bera_p = jb.p;
-  d.jarque_bera_available = jb.available;
-  const Check sw = shapiro_wilk_check(std::vector<double>(e_s.data(), e_s.data() + n));
-  d.shapiro_wilk_w = sw.statistic;
-  d.shapiro_wilk_p = sw.p;
-  d.shapiro_wilk_available = sw.available;
-  const Check bp = breusch_pagan_check(e_s, columns);
-  d.breusch_pagan_lm = bp.statistic;
-  d.breusch_pagan_p = bp.p;
-  d.breusch_pagan_available = bp.available;
-  const Check dw = durbin_watson_check(e_s);
-  d.durbin_watson = dw.available ? dw.statistic : 2.0;
-  d.durbin_watson_available = dw.available;
-
-  auto& warn = res.warnings;
-  const double alpha = options.alpha;
-  if (perfect)
-    warn.push_back(
-        fmt::format("perfect fit (residuals within {:.0e} of the response's spread): "
-                    "reported as exact, so sigma and the standard errors are 0, t and "
-                    "F are infinite, and the residual checks are unavailable",
-                    negligible_scaled));
-  if (jb.available && jb.p < alpha)
-    warn.push_back(fmt::format("residuals look non-normal: Jarque-Bera {} (p {} < alpha {})",
-                               g4(jb.statistic), p_text(jb.p), alpha));
-  if (sw.available && sw.p < alpha)
-    warn.push_back(fmt::format("residuals look non-normal: Shapiro-Wilk W {} (p {} < alpha {})",
-                               g4(sw.statistic), p_text(sw.p), alpha));
-  if (res.n < kShapiroWilkMinN || res.n > kShapiroWilkMaxN)
-    warn.push_back(fmt::format("Shapiro-Wilk not computed: n = {} is outside [{}, {}]", n,
-                               kShapiroWilkMinN, kShapiroWilkMaxN));
-  if (bp.available && bp.p < alpha)
-    warn.push_back(fmt::format(
-        "residuals look heteroscedastic: Breusch-Pagan (Koenker) LM {} (p {} < alpha {}); the "
-        "estimates stay unbiased but the t and F p values are not exact",
-        g4(bp.statistic), p_text(bp.p), alpha));
-  // No exact DW bounds for arbitrary designs; far from 2 is a clear sign on its own.
-  if (dw.available && (dw.statistic < 1.0 || dw.statistic > 3.0))
-    warn.push_back(
-        fmt::format("residuals look serially correlated: Durbin-Watson {} (outside "
-                    "[1, 3]; 2 means uncorrelated)",
-                    g4(dw.statistic)));
-  for (Index j = 0; j < k; ++j)
-    if (vif(j) > kVifWarning)
-      warn.push_back(fmt::format("multicollinearity: VIF of '{}' is {} (> {})",
-                                 names[static_cast<std::size_t>(j)], g4(vif(j)), kVifWarning));
-
-  // Data near the limits of double (|values| ~1e154 and up) can still overflow the unscaled
-  // sums of squares; say so rather than hand back infinities or NaN.
-  bool finite = std::isfinite(res.rss) && std::isfinite(res.tss) && std::isfinite(res.sigma) &&
-                std::isfinite(res.r2) && std::isfinite(res.adj_r2) && !std::isnan(res.f);
-  for (const auto& c : res.coefficients)
-    finite = finite && std::isfinite(c.estimate) && std::isfinite(c.std_error) && !std::isnan(c.t);
-  for (std::size_t i = 0; i < res.residuals.size(); ++i)
-    finite = finite && std::isfinite(res.residuals[i]) && std::isfinite(res.fitted[i]);
-  if (!finite)
-    throw UserError(
-        "ols: the data are too large in magnitude for double-precision sums of "
-        "squares; rescale y or the columns (e.g. change units)");
+  add_residual_checks(e_s, columns, names, vif, worst, condition, perfect, options, &res);
+  require_finite(res);
   return res;
 }
 

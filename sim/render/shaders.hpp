@@ -1,0 +1,293 @@
+// The renderer's GLSL sources (scene, sky, water; vertex and fragment), compiled by
+// sim/render/renderer.cpp. Their bytes decide every rendered image: a change here changes the
+// renders, and the byte-determinism and geometry tests say by how much.
+#pragma once
+
+namespace driftlab::sim::shaders {
+
+// Shaders come in variants chosen by #defines: DEPTH (linear depth instead of
+// gray) and SUN (sun glints, which need per-pixel normals and view vectors).
+// On llvmpipe the cost of a fragment is mostly the interpolation of its
+// inputs, so each variant carries only what it reads: lighting and fog are
+// smooth over a triangle and are evaluated per vertex (Gouraud).
+inline constexpr const char* kSceneVs = R"(
+layout(location = 0) in vec3 a_pos;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_uv;
+uniform mat4 u_view;       // world -> camera (optical)
+uniform mat4 u_proj;
+uniform float u_mirror;    // 1: as is; -1: mirrored about the water plane z = 0
+uniform vec3 u_sun_dir;    // towards the sun, world
+uniform float u_ambient;
+uniform float u_diffuse;
+uniform float u_fog;
+uniform vec3 u_eye;
+#if DEPTH
+out float v_view_z;
+#else
+out vec4 v_uv_light_fog;   // texture u, v; light; fog transmittance
+#endif
+#if SUN && !DEPTH
+out vec3 v_world;
+out vec3 v_normal;
+#endif
+void main() {
+  vec3 p = vec3(a_pos.xy, a_pos.z * u_mirror);
+  vec4 c = u_view * vec4(p, 1.0);
+#if DEPTH
+  v_view_z = c.z;
+#else
+  vec3 n = normalize(vec3(a_normal.xy, a_normal.z * u_mirror));
+  // Overcast light comes mostly from above (-z); the sun adds a directional term.
+  // Surfaces facing down still get light bounced from the water and ground.
+  float sky_light = mix(0.35, 1.0, 0.5 + 0.5 * clamp(-n.z, -1.0, 1.0));
+#if SUN
+  float light = u_ambient * sky_light + u_diffuse * max(dot(n, u_sun_dir), 0.0);
+  v_world = p;
+  v_normal = n;
+#else
+  float light = u_ambient * sky_light + u_diffuse * 0.6 * sky_light;
+#endif
+  v_uv_light_fog = vec4(a_uv, light, exp(-length(u_eye - p) / u_fog));
+#endif
+  // Mirrored pass: keep only what is above the water (z < 0 before mirroring).
+  gl_ClipDistance[0] = u_mirror < 0.0 ? -a_pos.z : 1.0;
+  gl_Position = u_proj * c;
+}
+)";
+
+inline constexpr const char* kSceneFs = R"(
+#if DEPTH
+in float v_view_z;
+#else
+in vec4 v_uv_light_fog;
+#endif
+#if SUN && !DEPTH
+in vec3 v_world;
+in vec3 v_normal;
+#endif
+uniform sampler2D u_tex;
+uniform bool u_has_tex;
+uniform float u_albedo;
+uniform float u_specular;
+uniform vec3 u_sun_dir;
+uniform float u_sky;
+uniform vec3 u_eye;
+out vec4 frag;
+void main() {
+#if DEPTH
+  frag = vec4(v_view_z, 0.0, 0.0, 1.0);
+#else
+  float t = u_has_tex ? texture(u_tex, v_uv_light_fog.xy).r : 1.0;
+  float g = u_albedo * t * v_uv_light_fog.z;
+#if SUN
+  if (u_specular > 0.0) {
+    vec3 n = normalize(v_normal);
+    vec3 v = normalize(u_eye - v_world);
+    vec3 h = normalize(v + u_sun_dir);
+    g += u_specular * pow(max(dot(n, h), 0.0), 60.0);
+  }
+#endif
+  frag = vec4(mix(u_sky, g, v_uv_light_fog.w), 0.0, 0.0, 1.0);
+#endif
+}
+)";
+
+// The sky: one triangle over the screen on the far plane. The (unnormalised)
+// viewing ray is affine in window coordinates, so it is computed at the
+// vertices and interpolated without perspective: exact, and cheap per pixel.
+inline constexpr const char* kSkyVs = R"(
+uniform mat4 u_inv_view_proj;
+noperspective out vec3 v_ray;
+void main() {
+  vec2 p = vec2((gl_VertexID == 1) ? 3.0 : -1.0, (gl_VertexID == 2) ? 3.0 : -1.0);
+  vec4 a = u_inv_view_proj * vec4(p, -1.0, 1.0);
+  vec4 b = u_inv_view_proj * vec4(p, 1.0, 1.0);
+  v_ray = b.xyz / b.w - a.xyz / a.w;
+  gl_Position = vec4(p, 1.0, 1.0);
+}
+)";
+
+inline constexpr const char* kSkyFs = R"(
+noperspective in vec3 v_ray;
+uniform float u_sky;
+uniform vec3 u_sun_dir;
+out vec4 frag;
+void main() {
+  vec3 d = normalize(v_ray);
+  float elevation = clamp(-d.z, 0.0, 1.0);   // z is down
+  float g = u_sky * (1.0 + 0.12 * elevation);
+#if SUN
+  g += 0.35 * pow(max(dot(d, u_sun_dir), 0.0), 200.0);
+#endif
+  frag = vec4(min(g, 1.0), 0.0, 0.0, 1.0);
+}
+)";
+
+// The water: a polar grid around the camera displaced by the wave components
+// (eta positive up, surface at z = -eta), normals from the analytic slope at
+// the vertices (as fine as the displaced geometry itself).
+inline constexpr const char* kWaterVs = R"(
+layout(location = 0) in vec2 a_grid;       // offset from the camera, world x/y
+const int N = 32;
+uniform vec4 u_wave_a[N];   // amplitude, kx, ky, omega
+uniform float u_wave_phase[N];
+uniform int u_wave_count;
+uniform float u_time;
+uniform vec2 u_centre;
+uniform mat4 u_view;
+uniform mat4 u_proj;
+uniform vec3 u_eye;
+uniform float u_fog;
+uniform float u_reflectivity;
+uniform float u_turbidity;
+#if DEPTH
+out float v_view_z;
+#else
+out vec4 v_shade;          // normal x, y (reflection offset); Fresnel; fog
+#endif
+#if (SUN || RIPPLES) && !DEPTH
+out vec3 v_world;
+#endif
+#if SUN && !DEPTH
+out vec3 v_normal;
+#endif
+void main() {
+  vec2 xy = u_centre + a_grid;
+  float eta = 0.0;
+  vec2 slope = vec2(0.0);
+  for (int i = 0; i < u_wave_count; ++i) {
+    float th = u_wave_a[i].y * xy.x + u_wave_a[i].z * xy.y - u_wave_a[i].w * u_time + u_wave_phase[i];
+    eta += u_wave_a[i].x * cos(th);
+    slope -= u_wave_a[i].x * sin(th) * u_wave_a[i].yz;
+  }
+  vec3 p = vec3(xy, -eta);
+  vec4 c = u_view * vec4(p, 1.0);
+#if DEPTH
+  v_view_z = c.z;
+#else
+  vec3 n = normalize(vec3(-slope, -1.0));   // upward normal (z is down)
+  vec3 v = normalize(u_eye - p);
+  float cos_t = clamp(dot(n, v), 0.0, 1.0);
+  // Schlick's approximation of the Fresnel reflectance of water (n = 1.33).
+  float m = 1.0 - cos_t, m2 = m * m;
+  float fresnel = (0.02 + 0.98 * m2 * m2 * m) * u_reflectivity * (1.0 - 0.5 * u_turbidity);
+  v_shade = vec4(n.xy, fresnel, exp(-length(u_eye - p) / u_fog));
+#if SUN || RIPPLES
+  v_world = p;
+#endif
+#if SUN
+  v_normal = n;
+#endif
+#endif
+  gl_Position = u_proj * c;
+}
+)";
+
+inline constexpr const char* kWaterFs = R"(
+#if DEPTH
+in float v_view_z;
+#else
+in vec4 v_shade;
+#endif
+#if (SUN || RIPPLES) && !DEPTH
+in vec3 v_world;
+#endif
+#if SUN && !DEPTH
+in vec3 v_normal;
+#endif
+const int R = 16;
+uniform vec4 u_ripple[R];       // kx, ky, omega, slope amplitude a k
+uniform float u_ripple_phase[R];
+uniform int u_ripple_count;
+uniform float u_time;
+uniform mat4 u_view;
+uniform vec2 u_focal;           // fx, fy [px]
+uniform float u_refl_max_lod;
+uniform vec3 u_eye;
+uniform sampler2D u_reflection;
+uniform bool u_has_reflection;
+uniform vec2 u_viewport;
+uniform float u_body;
+uniform float u_turbidity;
+uniform float u_sky;
+uniform vec3 u_sun_dir;
+out vec4 frag;
+#if RIPPLES && !DEPTH
+// Pixel position of the reflection in the mirror image of the ray from the
+// eye to this fragment, reflected off a surface of slope s (grad eta).
+vec2 mirror_px(vec2 s) {
+  vec3 d = normalize(v_world - u_eye);
+  vec3 r = mat3(u_view) * reflect(d, normalize(vec3(-s, -1.0)));
+  return u_focal * r.xy / max(r.z, 0.05);
+}
+#endif
+void main() {
+#if DEPTH
+  frag = vec4(v_view_z, 0.0, 0.0, 1.0);
+#else
+  float refl = u_sky;
+  if (u_has_reflection) {
+    vec2 uv = gl_FragCoord.xy / u_viewport + 0.15 * v_shade.xy * vec2(1.0, -1.0);
+#if RIPPLES
+    // Wind ripples: those at least 4 pixels long are drawn, fading out
+    // below (so they never alias); the slope variance of the shorter ones
+    // blurs the reflection instead, as a rough mirror does.
+    vec2 xy = v_world.xy;
+    float foot = max(length(dFdx(xy)), length(dFdy(xy)));  // water surface per pixel [m]
+    vec2 slope = vec2(0.0);
+    float unresolved = 0.0;
+    for (int i = 0; i < u_ripple_count; ++i) {
+      vec2 k = u_ripple[i].xy;
+      float keep = smoothstep(2.0, 4.0, 6.2831853 / (length(k) * foot));
+      float th = dot(k, xy) - u_ripple[i].z * u_time + u_ripple_phase[i];
+      slope -= keep * u_ripple[i].w * sin(th) * normalize(k);
+      unresolved += (1.0 - keep * keep) * 0.5 * u_ripple[i].w * u_ripple[i].w;
+    }
+    // Where the reflected ray through the rippled surface lands in the
+    // mirror image, against the ray through the flat surface: exact for
+    // the reflection of distant objects.
+    vec2 p0 = mirror_px(vec2(0.0)), p1 = mirror_px(slope);
+    uv += (p1 - p0) / u_viewport;
+    // The unresolved ripples spread the reflected rays: the spread of their
+    // image is J S J^T, J the Jacobian of mirror_px in the slope and S the
+    // slope covariance (isotropic). At grazing angles it is long and
+    // vertical (the streaks of a rippled reflection): the long axis is
+    // sampled in five taps, the short one by the mip level.
+    const float eps = 0.01;
+    mat2 J = mat2((mirror_px(slope + vec2(eps, 0.0)) - p1) / eps,
+                  (mirror_px(slope + vec2(0.0, eps)) - p1) / eps);
+    mat2 C = 0.5 * unresolved * J * transpose(J);
+    float half_tr = 0.5 * (C[0][0] + C[1][1]);
+    float det = C[0][0] * C[1][1] - C[0][1] * C[1][0];
+    float root = sqrt(max(half_tr * half_tr - det, 0.0));
+    float major = sqrt(half_tr + root), minor = sqrt(max(half_tr - root, 0.0));
+    vec2 axis = abs(C[1][0]) > 1e-9 ? normalize(vec2(half_tr + root - C[1][1], C[1][0]))
+                                    : (C[0][0] >= C[1][1] ? vec2(1.0, 0.0) : vec2(0.0, 1.0));
+    // A mip level of width w texels (2 w pixels) has a standard deviation
+    // of about w / 2.5 texels.
+    float lod = clamp(log2(max(1.25 * minor, 1.0)), 0.0, u_refl_max_lod);
+    vec2 step = axis * (major / 0.866) / u_viewport;  // taps -2..2 at 0.75 step: sd 0.866
+    const float w[5] = float[5](1.0, 2.0, 3.0, 2.0, 1.0);
+    float sum = 0.0;
+    for (int j = 0; j < 5; ++j)
+      sum += w[j] * textureLod(u_reflection, clamp(uv + (0.75 * float(j - 2)) * step,
+                                                   vec2(0.0), vec2(1.0)), lod).r;
+    refl = sum / 9.0;
+#else
+    refl = texture(u_reflection, clamp(uv, vec2(0.0), vec2(1.0))).r;
+#endif
+  }
+  float body = u_body * (0.6 + 0.8 * u_turbidity);
+  float g = mix(body, refl, v_shade.z);
+#if SUN
+  vec3 n = normalize(v_normal);
+  vec3 r = reflect(-normalize(u_eye - v_world), n);
+  g += 0.8 * pow(max(dot(r, u_sun_dir), 0.0), 300.0);
+#endif
+  frag = vec4(mix(u_sky, g, v_shade.w), 0.0, 0.0, 1.0);
+#endif
+}
+)";
+
+}  // namespace driftlab::sim::shaders
