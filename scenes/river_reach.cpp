@@ -102,12 +102,7 @@ struct Textures {
 
 Textures add_textures(sim::SceneGeometry* g, std::uint64_t seed, double contrast) {
   const RngStreams streams(seed);
-  // One stream per texture: changing one texture's code leaves the others' bytes alone.
-  auto add = [&](TextureKind kind) {
-    Rng rng = streams.stream("scene.texture." + std::string(texture_kind_name(kind)));
-    g->textures.push_back(make_texture(kind, rng, contrast));
-    return static_cast<int>(g->textures.size() - 1);
-  };
+  auto add = [&](TextureKind kind) { return add_scene_texture(g, streams, kind, contrast); };
   Textures t{};
   t.grass = add(TextureKind::kGrass);
   t.soil = add(TextureKind::kSoil);

@@ -525,4 +525,13 @@ sim::Texture make_texture(TextureKind kind, Rng& rng, double contrast, int varia
   return finish(kind, c, contrast, variant);
 }
 
+int add_scene_texture(sim::SceneGeometry* g, const RngStreams& streams, TextureKind kind,
+                      double contrast, int variant) {
+  std::string name = "scene.texture." + std::string(texture_kind_name(kind));
+  if (kind == TextureKind::kPoster) name += std::to_string(variant);
+  Rng rng = streams.stream(name);
+  g->textures.push_back(make_texture(kind, rng, contrast, variant));
+  return static_cast<int>(g->textures.size() - 1);
+}
+
 }  // namespace driftlab::scenes

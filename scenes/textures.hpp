@@ -47,4 +47,10 @@ constexpr int kPosterVariants = 4;
 sim::Texture make_texture(TextureKind kind, Rng& rng, double contrast = 1.0, int variant = 0,
                           int size_px = 0);
 
+/// Adds a texture of `kind` to the scene, drawn from its own stream
+/// "scene.texture.KIND" (posters: "scene.texture.posterVARIANT"), so that changing one
+/// texture's code leaves the others' bytes alone; returns its index in g->textures.
+int add_scene_texture(sim::SceneGeometry* g, const RngStreams& streams, TextureKind kind,
+                      double contrast = 1.0, int variant = 0);
+
 }  // namespace driftlab::scenes

@@ -64,11 +64,7 @@ struct BasinTextures {
 // The hall's textures, each from its own random stream.
 BasinTextures add_textures(sim::SceneGeometry* g, const RngStreams& streams) {
   auto add_texture = [&](TextureKind kind, int variant = 0) {
-    std::string name = "scene.texture." + std::string(texture_kind_name(kind));
-    if (kind == TextureKind::kPoster) name += std::to_string(variant);
-    Rng rng = streams.stream(name);
-    g->textures.push_back(make_texture(kind, rng, 1.0, variant));
-    return static_cast<int>(g->textures.size() - 1);
+    return add_scene_texture(g, streams, kind, 1.0, variant);
   };
   BasinTextures t{};
   t.wall = add_texture(TextureKind::kPaintedWall);

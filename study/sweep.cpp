@@ -1,29 +1,17 @@
 #include "study/sweep.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <functional>
 #include <map>
-#include <set>
-#include <sstream>
 
-#include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
-#include "core/rng.hpp"
 #include "core/yaml_io.hpp"
-#include "pipeline/scenario.hpp"
 
 namespace driftlab::study {
 
-using pipeline::load_scenario;
-using pipeline::parse_scenario;
-using pipeline::resolved_yaml;
-using pipeline::Scenario;
 namespace fs = std::filesystem;
 
 namespace {
