@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <stdexcept>
+#include <string>
 
 namespace driftlab::app {
 
@@ -33,5 +34,11 @@ struct UsageError : std::runtime_error {
 /// CLI11 printed why; --help and --version exit 0), UsageError to kExitUsage, UserError to
 /// kExitUserError, Unavailable to kExitUnavailable and any other exception to kExitInternal.
 int run_cli_main(CLI::App& app, int argc, char** argv, const std::function<int()>& dispatch);
+
+/// A generated key reference (`driftlab scenario|sweep|regress schema`): "# TITLE", a line
+/// saying which command generated it and `intro`, then the table; written to `out`
+/// (atomically) or, when `out` is empty, to standard output. Returns kExitOk.
+int print_reference(const std::string& title, const std::string& command, const std::string& intro,
+                    const std::string& table, const std::string& out);
 
 }  // namespace driftlab::app

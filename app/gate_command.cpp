@@ -37,6 +37,9 @@ GateCommand::GateCommand(CLI::App* cmd) : cmd_(cmd) {
       ->check(CLI::NonNegativeNumber);
   init_->add_option("--description", description_, "What the baseline protects");
   init_->add_flag("--force", force_, "Replace an existing baseline file");
+  schema_ =
+      cmd_->add_subcommand("schema", "Print the reference of every baseline-file key (Markdown)");
+  schema_->add_option("--out", schema_out_, "Write to this file instead of standard output");
   cmd_->require_subcommand(0, 1);
 }
 
@@ -67,6 +70,12 @@ std::optional<int> GateCommand::dispatch() {
 
 int GateCommand::run() {
   if (init_->parsed()) return init();
+  if (schema_->parsed())
+    return print_reference("Baseline file reference", "driftlab regress schema",
+                           "A baseline is JSON (or YAML). A key whose\nconstraint says "
+                           "required must be given; the others take the default shown. Unknown "
+                           "keys are errors.",
+                           gate::baseline_reference_markdown(), schema_out_);
   if (baseline_.empty() || results_.empty())
     throw UsageError("regress: --baseline and --results are required (or `regress init`)");
   if (update_ && !fs::exists(baseline_))

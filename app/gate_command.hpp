@@ -27,6 +27,8 @@ class GateCommand {
 
   CLI::App* cmd_;
   CLI::App* init_ = nullptr;
+  CLI::App* schema_ = nullptr;
+  std::string schema_out_;
   std::string baseline_, results_, junit_;
   bool update_ = false;
   std::string init_results_, init_baseline_, description_;

@@ -100,6 +100,10 @@ StudyCommands::StudyCommands(CLI::App& app) {
                      "Run-level regression METRIC~AXIS[+AXIS...] (repeatable), e.g. "
                      "basin_north_rmse_m~amplitude_m+wavelength_m");
 
+  schema_ =
+      sweep_->add_subcommand("schema", "Print the reference of every sweep-file key (Markdown)");
+  schema_->add_option("--out", schema_out_, "Write to this file instead of standard output");
+
   slurm_ = sweep_->add_subcommand(
       "slurm-script", "Write DIR/slurm/sweep.sbatch: a Slurm job array over shards of the jobs");
   slurm_->add_option("DIR", dir_, "Sweep folder")->required();
@@ -166,6 +170,11 @@ std::optional<int> StudyCommands::dispatch() {
   if (status_->parsed()) return status();
   if (merge_->parsed()) return merge();
   if (slurm_->parsed()) return slurm_script();
+  if (schema_->parsed())
+    return print_reference("Sweep file reference", "driftlab sweep schema",
+                           "A key whose constraint says required must be given; the others\n"
+                           "take the default shown. Unknown keys are errors. See docs/sweeps.md.",
+                           pl::sweep_reference_markdown(), schema_out_);
   if (run_cmd_ && run_cmd_->parsed() && !manifest_.empty()) return run_manifest();
   return std::nullopt;
 }

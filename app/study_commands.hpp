@@ -41,9 +41,10 @@ class StudyCommands {
   CLI::App* status_ = nullptr;
   CLI::App* merge_ = nullptr;
   CLI::App* slurm_ = nullptr;
+  CLI::App* schema_ = nullptr;
   CLI::App* run_cmd_ = nullptr;
 
-  std::string sweep_file_, dir_, out_;
+  std::string sweep_file_, dir_, out_, schema_out_;
   bool force_ = false;
   std::size_t parallel_ = 1;
   std::vector<std::string> covariates_, run_regressions_;

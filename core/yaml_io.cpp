@@ -30,6 +30,8 @@ Check Check::operator&(const Check& o) const {
   c.non_empty_string = c.non_empty_string || o.non_empty_string;
   if (o.choices) c.choices = o.choices;
   if (!o.why.empty()) c.why = c.why.empty() ? o.why : c.why + "; " + o.why;
+  c.required = c.required || o.required;
+  if (!o.expected.empty()) c.expected = o.expected;
   return c;
 }
 
@@ -37,6 +39,7 @@ bool Check::has_bounds() const { return std::isfinite(lo) || std::isfinite(hi); 
 
 std::string Check::describe() const {
   std::vector<std::string> parts;
+  if (required) parts.push_back("required");
   const bool has_lo = std::isfinite(lo);
   const bool has_hi = std::isfinite(hi);
   if (has_lo && has_hi) {
@@ -232,27 +235,73 @@ void Reader::check_number(const YAML::Node& node, const std::string& key_path, d
                           const Check& check) {
   const bool low = check.lo_open ? !(v > check.lo) : !(v >= check.lo);
   const bool high = check.hi_open ? !(v < check.hi) : !(v <= check.hi);
-  if (low || high) {
-    Check bounds{.lo = check.lo,
-                 .hi = check.hi,
-                 .lo_open = check.lo_open,
-                 .hi_open = check.hi_open,
-                 .why = check.why};
-    fail(node, key_path, format_double(v), "a value " + bounds.describe());
+  if (!(low || high)) return;
+  if (!check.expected.empty()) {
+    fail(node, key_path, describe_node(node), check.expected);
+    return;
   }
+  Check bounds{.lo = check.lo,
+               .hi = check.hi,
+               .lo_open = check.lo_open,
+               .hi_open = check.hi_open,
+               .why = check.why};
+  fail(node, key_path, format_double(v), "a value " + bounds.describe());
 }
 
-void Reader::require(bool ok, const char* key, const char* expected) {
-  if (ok || !check_rules_) return;
+YAML::Node Reader::value_of(std::string_view key) const {
   // yaml-cpp's Node::operator= writes through to the referenced node; reset() rebinds.
-  YAML::Node node;
-  node.reset(map_);
+  YAML::Node node(YAML::NodeType::Undefined);
   for (const auto& [k, v] : entries_) {
-    if (k.IsScalar() && k.Scalar() == key) node.reset(v);
+    if (k.IsScalar() && k.Scalar() == key) {
+      node.reset(v);
+      break;
+    }
   }
-  std::string got = node.IsScalar() ? "'" + node.Scalar() + "'" : "the value given";
-  if (node.IsScalar() && node.Scalar() == "") got = "the value given";
+  return node;
+}
+
+void Reader::missing(const char* key, const Check& check) {
+  missing_.emplace_back(key);
+  // A missing top-level key has no place in the file but the file itself.
+  errors_->add(fmt::format("{}: {}: missing, expected {}",
+                           prefix_.empty() ? source_.name : where(map_), path(key),
+                           check.expected.empty() ? "a value" : check.expected));
+}
+
+void Reader::location(const char* key, std::string* out) const {
+  const YAML::Node node = value_of(key);
+  *out = where(node.IsDefined() ? node : map_);
+}
+
+void Reader::require(bool ok, const char* key, std::string_view expected) {
+  if (ok || !check_rules_) return;
+  if (std::find(missing_.begin(), missing_.end(), key) != missing_.end()) return;
+  YAML::Node node = value_of(key);
+  if (!node.IsDefined()) node.reset(map_);
+  std::string got = "the value given";
+  if (node.IsScalar() && !node.Scalar().empty()) got = "'" + node.Scalar() + "'";
+  if (node.IsSequence())
+    got = node.size() == 0 ? "an empty list" : fmt::format("a list of {}", node.size());
   errors_->add(fmt::format("{}: {}: got {}, expected {}", where(node), path(key), got, expected));
+}
+
+void Reader::exactly_one_of(std::initializer_list<const char*> keys) {
+  if (!check_rules_) return;
+  std::string names;
+  std::vector<std::pair<std::string, YAML::Node>> given;
+  for (const char* key : keys) {
+    names += (names.empty() ? "" : ", ") + std::string(key);
+    // Null is "not given", as for an optional field.
+    if (YAML::Node n = value_of(key); n.IsDefined() && !n.IsNull()) given.emplace_back(key, n);
+  }
+  const std::string here = prefix_.empty() ? "(top level)" : prefix_;
+  if (given.empty()) {
+    errors_->add(fmt::format("{}: {}: got none of {}, expected exactly one of them", where(map_),
+                             here, names));
+  } else if (given.size() > 1) {
+    errors_->add(fmt::format("{}: {}: got both {} and {}, expected exactly one of: {}",
+                             where(given[1].second), here, given[0].first, given[1].first, names));
+  }
 }
 
 void Reader::finish() {
@@ -423,14 +472,14 @@ void Validator::check_double(const std::string& key_path, double v, const Check&
   }
 }
 
-void Validator::require(bool ok, const char* key, const char* expected) {
+void Validator::require(bool ok, const char* key, std::string_view expected) {
   if (!ok) errors_->add(fmt::format("{}: expected {}", path(key), expected));
 }
 
 // ---------------------------------------------------------------------------
 // Schema
 
-void SchemaBuilder::require(bool, const char* key, const char* expected) {
+void SchemaBuilder::require(bool, const char* key, std::string_view expected) {
   const std::string key_path = prefix_.empty() ? key : prefix_ + "." + key;
   for (auto& row : *rows_) {
     if (row.key_path == key_path) {
@@ -438,6 +487,27 @@ void SchemaBuilder::require(bool, const char* key, const char* expected) {
       return;
     }
   }
+}
+
+void SchemaBuilder::exactly_one_of(std::initializer_list<const char*> keys) {
+  std::string names;
+  for (const char* key : keys) names += (names.empty() ? "" : ", ") + std::string(key);
+  for (const char* key : keys) require(false, key, "exactly one of " + names);
+}
+
+// ---------------------------------------------------------------------------
+// Any
+
+std::string Any::flow_text() const {
+  YAML::Emitter e;
+  e.SetSeqFormat(YAML::Flow);
+  e.SetMapFormat(YAML::Flow);
+  if (node.IsScalar()) {
+    e << node.Scalar();
+  } else {
+    e << node;
+  }
+  return e.c_str();
 }
 
 std::string schema_markdown(const std::vector<SchemaRow>& rows) {

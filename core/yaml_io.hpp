@@ -19,15 +19,27 @@
 //
 // Supported field types: bool, int, int64_t, uint64_t, double, std::string, enums
 // with an ADL `enum_table(E)` (array of {E, "name"} pairs), nested visitable
-// structs, std::vector<T> and std::array<T, N> of any of these.
+// structs, std::vector<T> and std::array<T, N> of any of these, std::optional<T>
+// (absent or null: nullopt), yaml::Any (any YAML value, kept as written) and
+// yaml::Entries<T> (a mapping of names of the user's choosing to T, in file order).
+//
+// Besides fields, visit() may state rules across them, which only the archives that need
+// them act on:
+//   a.require(ok, "key", "what is expected");       // reader, validator, reference
+//   a.exactly_one_of({"values", "range"});           // reader (presence), reference
+//   a.location(&where); a.location("key", &where);   // reader: "FILE:LINE:COL" of the
+//                                                    // mapping, or of a key's value
+// Every input file is read this way (scenarios, sweeps, CI baselines): one strict reader.
 #pragma once
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <limits>
 #include <optional>
 #include <string>
@@ -59,6 +71,11 @@ struct Check {
   /// Why the bounds are what they are (a plausible range's reason), shown after them in
   /// messages and in the reference.
   std::string why{};
+  /// The key must be present (readers report "missing, expected EXPECTED").
+  bool required = false;
+  /// What is expected, in words, replacing the generated text in messages (the value is
+  /// then quoted as written: "got '-1', expected a number >= 0").
+  std::string expected{};
 
   /// Combine two checks (both must hold).
   Check operator&(const Check& o) const;
@@ -91,6 +108,12 @@ inline Check non_empty() { return {.min_size = 1, .non_empty_string = true}; }
 inline Check one_of(std::function<std::vector<std::string>()> names) {
   return {.choices = std::move(names)};
 }
+/// The key must be given; `expected` says what in words.
+inline Check required(std::string expected) {
+  return {.required = true, .expected = std::move(expected)};
+}
+/// Messages say `expected` instead of the generated description.
+inline Check expecting(std::string expected) { return {.expected = std::move(expected)}; }
 /// "one of: a, b, c" when `name` is not among check.choices(); empty when it is (or no choices).
 std::string unknown_choice(const Check& check, const std::string& name);
 
@@ -107,6 +130,45 @@ struct is_std_array : std::false_type {};
 template <class T, std::size_t N>
 struct is_std_array<std::array<T, N>> : std::true_type {};
 
+template <class T>
+struct is_std_optional : std::false_type {};
+template <class T>
+struct is_std_optional<std::optional<T>> : std::true_type {};
+
+/// Any YAML value, kept as written, with where it was ("FILE:LINE:COL"): sweep levels and
+/// fixed scenario values, read and checked later against the scenario they apply to.
+struct Any {
+  YAML::Node node;
+  std::string where;
+
+  Any() = default;
+  Any(const Any& o) : node(o.node), where(o.where) {}
+  // yaml-cpp's Node::operator= writes through to the node it refers to; reset() rebinds.
+  Any& operator=(const Any& o) {
+    node.reset(o.node);
+    where = o.where;
+    return *this;
+  }
+  /// YAML text for a KEY=VALUE override: a scalar as written, lists and mappings in flow
+  /// style ("[1, 2]", "{a: 1}").
+  std::string flow_text() const;
+};
+
+/// One entry of a mapping whose keys the user names (e.g. scenario key paths -> values).
+template <class T>
+struct Entry {
+  std::string key;
+  T value{};
+  std::string where;  ///< "FILE:LINE:COL" of the key
+};
+template <class T>
+using Entries = std::vector<Entry<T>>;
+
+template <class T>
+struct is_entries : std::false_type {};
+template <class T, class Alloc>
+struct is_entries<std::vector<Entry<T>, Alloc>> : std::true_type {};
+
 struct ProbeArchive;  // used only to detect visitable structs
 
 template <class T>
@@ -118,6 +180,9 @@ template <class T>
 struct is_vector_of_visitable : std::false_type {};
 template <Visitable T, class Alloc>
 struct is_vector_of_visitable<std::vector<T, Alloc>> : std::true_type {};
+
+template <class T>
+concept OptionalOfVisitable = is_std_optional<T>::value && Visitable<typename T::value_type>;
 
 template <class T>
 concept Enum = std::is_enum_v<T> && requires(T e) {
@@ -152,12 +217,20 @@ std::optional<E> enum_from_name(std::string_view text) {
   return std::nullopt;
 }
 
-struct ProbeArchive {
-  template <class T>
-  void operator()(const char*, T&, const char*, const Check& = {}) {}
-  void require(bool, const char*, const char*) {}
+// The rules and locations every archive accepts; those that do not act on them inherit
+// these no-ops.
+struct IgnoresRules {
+  void require(bool, const char*, std::string_view) {}
+  void exactly_one_of(std::initializer_list<const char*>) {}
+  void location(std::string*) {}
+  void location(const char*, std::string*) {}
   template <class F>
   void when_reading(F&&) {}
+};
+
+struct ProbeArchive : IgnoresRules {
+  template <class T>
+  void operator()(const char*, T&, const char*, const Check& = {}) {}
 };
 
 // ---------------------------------------------------------------------------
@@ -201,12 +274,22 @@ class Reader {
   template <class T>
   void operator()(const char* key, T& value, const char* /*doc*/, const Check& check = {}) {
     YAML::Node node = find(key);
-    if (!node) return;
+    if (!node) {
+      if (check.required && check_rules_) missing(key, check);  // partial documents: later
+      return;
+    }
     read_value(node, path(key), value, check);
   }
 
   /// Cross-field rule, evaluated with the values read so far (write it after the fields).
-  void require(bool ok, const char* key, const char* expected);
+  /// Skipped for a required key found missing (that message already says what is expected).
+  void require(bool ok, const char* key, std::string_view expected);
+  /// Exactly one of these keys must be present ("got both values and range").
+  void exactly_one_of(std::initializer_list<const char*> keys);
+  /// "FILE:LINE:COL" of the mapping being read, or of the value of `key` (the mapping's
+  /// when the key is absent).
+  void location(std::string* out) const { *out = where(map_); }
+  void location(const char* key, std::string* out) const;
   void set_check_rules(bool on) { check_rules_ = on; }
 
   /// Runs `f` now: lets a struct react to a value just read (e.g. a preset
@@ -224,6 +307,8 @@ class Reader {
 
  private:
   YAML::Node find(const char* key);
+  YAML::Node value_of(std::string_view key) const;  // Undefined when absent
+  void missing(const char* key, const Check& check);
   std::string path(std::string_view key) const;
   void fail(const YAML::Node& node, const std::string& key_path, const std::string& got,
             const std::string& expected);
@@ -231,6 +316,9 @@ class Reader {
   template <class T>
   void read_value(const YAML::Node& node, const std::string& key_path, T& value,
                   const Check& check);
+  template <class T>
+  void read_entries(const YAML::Node& node, const std::string& key_path, Entries<T>& value,
+                    const Check& check);
 
   bool read_scalar_text(const YAML::Node& node, const std::string& key_path, const char* expected,
                         std::string* text);
@@ -243,6 +331,7 @@ class Reader {
   std::string prefix_;
   ErrorList* errors_;
   std::vector<std::string> seen_;
+  std::vector<std::string> missing_;  // required keys found missing
   bool check_rules_ = true;
 };
 
@@ -256,7 +345,25 @@ std::string describe_node(const YAML::Node& node);
 template <class T>
 void Reader::read_value(const YAML::Node& node, const std::string& key_path, T& value,
                         const Check& check) {
-  if constexpr (std::is_same_v<T, bool>) {
+  if constexpr (is_std_optional<T>::value) {
+    // Null is "not given", and so is a value that did not read (its error is reported).
+    if (node.IsNull()) {
+      value.reset();
+      return;
+    }
+    typename T::value_type v = value.value_or(typename T::value_type{});
+    const std::size_t errors_before = errors_->messages().size();
+    read_value(node, key_path, v, check);
+    if (errors_->messages().size() == errors_before)
+      value = std::move(v);
+    else
+      value.reset();
+  } else if constexpr (std::is_same_v<T, Any>) {
+    value.node.reset(node);
+    value.where = where(node);
+  } else if constexpr (is_entries<T>::value) {
+    read_entries(node, key_path, value, check);
+  } else if constexpr (std::is_same_v<T, bool>) {
     std::string text;
     if (!read_scalar_text(node, key_path, "true or false", &text)) return;
     if (text == "true") {
@@ -267,27 +374,32 @@ void Reader::read_value(const YAML::Node& node, const std::string& key_path, T& 
       fail(node, key_path, "'" + text + "'", "true or false");
     }
   } else if constexpr (std::is_same_v<T, double>) {
+    const std::string said = check.expected.empty() ? "a number" : check.expected;
     std::string text;
-    if (!read_scalar_text(node, key_path, "a number", &text)) return;
+    if (!read_scalar_text(node, key_path, said.c_str(), &text)) return;
     double v = 0;
     if (!parse_double(text, &v)) {
-      fail(node, key_path, "'" + text + "'", "a number");
+      fail(node, key_path, "'" + text + "'", said);
       return;
     }
     if (!std::isfinite(v)) {
-      fail(node, key_path, "'" + text + "'", "a finite number");
+      fail(node, key_path, "'" + text + "'",
+           check.expected.empty() ? "a finite number" : check.expected);
       return;
     }
     check_number(node, key_path, v, check);
     value = v;
   } else if constexpr (std::is_integral_v<T>) {
     std::string text;
-    if (!read_scalar_text(node, key_path, "an integer", &text)) return;
+    if (!read_scalar_text(node, key_path,
+                          check.expected.empty() ? "an integer" : check.expected.c_str(), &text))
+      return;
     std::int64_t v = 0;
     if constexpr (std::is_unsigned_v<T>) {
       std::uint64_t u = 0;
       if (!parse_uint64(text, &u) || u > std::numeric_limits<T>::max()) {
-        fail(node, key_path, "'" + text + "'", "a non-negative integer");
+        fail(node, key_path, "'" + text + "'",
+             check.expected.empty() ? "a non-negative integer" : check.expected);
         return;
       }
       check_number(node, key_path, static_cast<double>(u), check);
@@ -295,7 +407,8 @@ void Reader::read_value(const YAML::Node& node, const std::string& key_path, T& 
     } else {
       if (!parse_int64(text, &v) || v < std::numeric_limits<T>::min() ||
           v > std::numeric_limits<T>::max()) {
-        fail(node, key_path, "'" + text + "'", "an integer");
+        fail(node, key_path, "'" + text + "'",
+             check.expected.empty() ? "an integer" : check.expected);
         return;
       }
       check_number(node, key_path, static_cast<double>(v), check);
@@ -303,9 +416,12 @@ void Reader::read_value(const YAML::Node& node, const std::string& key_path, T& 
     }
   } else if constexpr (std::is_same_v<T, std::string>) {
     std::string text;
-    if (!read_scalar_text(node, key_path, "a string", &text)) return;
+    if (!read_scalar_text(node, key_path,
+                          check.expected.empty() ? "a string" : check.expected.c_str(), &text))
+      return;
     if (check.non_empty_string && text.empty()) {
-      fail(node, key_path, "an empty string", "a non-empty string");
+      fail(node, key_path, "an empty string",
+           check.expected.empty() ? "a non-empty string" : check.expected);
       return;
     }
     if (const std::string expected = unknown_choice(check, text); !expected.empty()) {
@@ -365,6 +481,36 @@ void Reader::read_value(const YAML::Node& node, const std::string& key_path, T& 
   }
 }
 
+template <class T>
+void Reader::read_entries(const YAML::Node& node, const std::string& key_path, Entries<T>& value,
+                          const Check& check) {
+  if (!node.IsMap()) {
+    fail(node, key_path, describe_node(node),
+         check.expected.empty() ? "a mapping of names to values" : check.expected);
+    return;
+  }
+  Entries<T> out;
+  for (const auto& kv : node) {
+    const YAML::Node k = kv.first;
+    if (!k.IsScalar() || k.Scalar().empty()) {
+      fail(k, key_path, describe_node(k), "a plain, non-empty name");
+      continue;
+    }
+    const std::string name = k.Scalar();
+    if (std::any_of(out.begin(), out.end(), [&](const auto& e) { return e.key == name; })) {
+      errors_->add(where(k) + ": " + key_path + "." + name +
+                   ": duplicate key, expected each key once");
+      continue;
+    }
+    Entry<T> e{.key = name, .where = where(k)};
+    Check element_check = check;
+    element_check.expected.clear();
+    read_value(kv.second, key_path + "." + name, e.value, element_check);
+    out.push_back(std::move(e));
+  }
+  value = std::move(out);
+}
+
 /// Reads `node` (a map) onto `value`, throwing UserError listing every problem.
 /// With `check_rules` false the cross-field rules (require()) are skipped: for
 /// partial documents such as one `--set` among several, whose rules only hold
@@ -396,7 +542,7 @@ YAML::Node override_document(const std::string& assignment);
 // ---------------------------------------------------------------------------
 // Writer: every field, in visit order, with its doc as a trailing comment.
 
-class Writer {
+class Writer : public IgnoresRules {
  public:
   explicit Writer(int indent = 0, bool comments = true) : indent_(indent), comments_(comments) {}
 
@@ -404,9 +550,6 @@ class Writer {
   void operator()(const char* key, const T& value, const char* doc, const Check& = {}) {
     write_field(key, value, doc);
   }
-  void require(bool, const char*, const char*) {}
-  template <class F>
-  void when_reading(F&&) {}
 
   const std::string& str() const { return out_; }
 
@@ -427,7 +570,11 @@ std::string quote_string(const std::string& s);
 
 template <class T>
 std::string Writer::scalar(const T& value) {
-  if constexpr (std::is_same_v<T, bool>) {
+  if constexpr (is_std_optional<T>::value) {
+    return value ? scalar(*value) : "null";
+  } else if constexpr (std::is_same_v<T, Any>) {
+    return value.node ? value.flow_text() : "null";
+  } else if constexpr (std::is_same_v<T, bool>) {
     return value ? "true" : "false";
   } else if constexpr (std::is_same_v<T, double>) {
     return format_double(value);
@@ -451,7 +598,21 @@ std::string Writer::scalar(const T& value) {
 
 template <class T>
 void Writer::write_field(const char* key, const T& value, const char* doc) {
-  if constexpr (Visitable<T>) {
+  if constexpr (is_std_optional<T>::value) {
+    if (value)
+      write_field(key, *value, doc);
+    else
+      line(std::string(key) + ": null", doc);
+  } else if constexpr (is_entries<T>::value) {
+    if (value.empty()) {
+      line(std::string(key) + ": {}", doc);
+      return;
+    }
+    line(std::string(key) + ":", doc);
+    Writer sub(indent_ + 2, comments_);
+    for (const auto& e : value) sub.write_field(e.key.c_str(), e.value, nullptr);
+    out_ += sub.str();
+  } else if constexpr (Visitable<T>) {
     line(std::string(key) + ":", doc);
     Writer sub(indent_ + 2, comments_);
     const_cast<T&>(value).visit(sub);  // the writer only reads the fields
@@ -486,7 +647,7 @@ std::string to_yaml(const T& value, bool comments = true) {
 // ---------------------------------------------------------------------------
 // Validation of a struct built in code (same rules as the reader).
 
-class Validator {
+class Validator : public IgnoresRules {
  public:
   Validator(std::string prefix, ErrorList* errors) : prefix_(std::move(prefix)), errors_(errors) {}
 
@@ -494,9 +655,7 @@ class Validator {
   void operator()(const char* key, const T& value, const char*, const Check& check = {}) {
     check_value(path(key), value, check);
   }
-  void require(bool ok, const char* key, const char* expected);
-  template <class F>
-  void when_reading(F&&) {}
+  void require(bool ok, const char* key, std::string_view expected);
 
  private:
   std::string path(std::string_view key) const;
@@ -510,8 +669,12 @@ class Validator {
 
 template <class T>
 void Validator::check_value(const std::string& key_path, const T& value, const Check& check) {
-  if constexpr (std::is_floating_point_v<T> ||
-                (std::is_integral_v<T> && !std::is_same_v<T, bool>)) {
+  if constexpr (is_std_optional<T>::value) {
+    if (value) check_value(key_path, *value, check);
+  } else if constexpr (is_entries<T>::value) {
+    for (const auto& e : value) check_value(key_path + "." + e.key, e.value, check);
+  } else if constexpr (std::is_floating_point_v<T> ||
+                       (std::is_integral_v<T> && !std::is_same_v<T, bool>)) {
     check_double(key_path, static_cast<double>(value), check);
   } else if constexpr (std::is_same_v<T, std::string>) {
     if (check.non_empty_string && value.empty())
@@ -565,7 +728,7 @@ struct SchemaRow {
   std::string doc;
 };
 
-class SchemaBuilder {
+class SchemaBuilder : public IgnoresRules {
  public:
   SchemaBuilder(std::string prefix, std::vector<SchemaRow>* rows)
       : prefix_(std::move(prefix)), rows_(rows) {}
@@ -574,9 +737,8 @@ class SchemaBuilder {
   void operator()(const char* key, const T& value, const char* doc, const Check& check = {}) {
     add(key, value, doc, check);
   }
-  void require(bool, const char* key, const char* expected);
-  template <class F>
-  void when_reading(F&&) {}
+  void require(bool, const char* key, std::string_view expected);
+  void exactly_one_of(std::initializer_list<const char*> keys);
 
  private:
   template <class T>
@@ -590,7 +752,14 @@ class SchemaBuilder {
 
 template <class T>
 std::string SchemaBuilder::type_name() {
-  if constexpr (std::is_same_v<T, bool>) {
+  if constexpr (is_std_optional<T>::value) {
+    return type_name<typename T::value_type>() + " or null";
+  } else if constexpr (std::is_same_v<T, Any>) {
+    return "any value";
+  } else if constexpr (is_entries<T>::value) {
+    return "mapping of names to " +
+           type_name<decltype(std::declval<typename T::value_type>().value)>();
+  } else if constexpr (std::is_same_v<T, bool>) {
     return "bool";
   } else if constexpr (std::is_same_v<T, double>) {
     return "number";
@@ -615,13 +784,18 @@ std::string SchemaBuilder::type_name() {
 template <class T>
 void SchemaBuilder::add(const char* key, const T& value, const char* doc, const Check& check) {
   const std::string key_path = prefix_.empty() ? key : prefix_ + "." + key;
-  if constexpr (Visitable<T>) {
+  if constexpr (OptionalOfVisitable<T>) {
+    rows_->push_back({key_path, "mapping or null", "null", check.describe(), doc});
+    typename T::value_type inner{};
+    SchemaBuilder sub(key_path, rows_);
+    inner.visit(sub);
+  } else if constexpr (Visitable<T>) {
     rows_->push_back({key_path, "mapping", "", "", doc});
     SchemaBuilder sub(key_path, rows_);
     const_cast<T&>(value).visit(sub);
   } else if constexpr (is_vector_of_visitable<T>::value) {
-    rows_->push_back(
-        {key_path, "list of mappings", value.empty() ? "[]" : "(see scenario)", "", doc});
+    rows_->push_back({key_path, "list of mappings", value.empty() ? "[]" : "(see scenario)",
+                      check.describe(), doc});
     typename T::value_type element{};
     SchemaBuilder sub(key_path + "[]", rows_);
     element.visit(sub);

@@ -18,12 +18,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string where_of(const std::string& label, const YAML::Node& node) {
-  const YAML::Mark m = node.Mark();
-  if (m.is_null()) return label;
-  return fmt::format("{}:{}:{}", label, m.line + 1, m.column + 1);
-}
-
 std::string g(double v) { return fmt::format("{:.6g}", v); }
 
 }  // namespace
@@ -33,121 +27,24 @@ double BaselineMetric::tolerance() const {
 }
 
 Baseline load_baseline(const fs::path& file) {
-  const std::string label = file.string();
-  const YAML::Node root = yaml::load_file(label);
-  yaml::ErrorList errors;
   Baseline b;
+  yaml::read_into(yaml::load_file(file.string()), yaml::Source{file.string()}, &b);
   b.file = file;
-  auto fail = [&](const YAML::Node& n, const std::string& path, const std::string& got,
-                  const std::string& expected) {
-    errors.add(fmt::format("{}: {}: got {}, expected {}", where_of(label, n), path, got, expected));
-  };
-  auto unknown_keys = [&](const YAML::Node& map, const std::string& prefix,
-                          const std::vector<std::string>& known) {
-    std::set<std::string> seen;
-    for (auto it = map.begin(); it != map.end(); ++it) {
-      const std::string k = it->first.IsScalar() ? it->first.Scalar() : "";
-      const std::string path = prefix.empty() ? k : prefix + "." + k;
-      if (!seen.insert(k).second) {
-        errors.add(fmt::format("{}: {}: duplicate key, expected each key once",
-                               where_of(label, it->first), path));
-        continue;
-      }
-      if (std::find(known.begin(), known.end(), k) != known.end()) continue;
-      std::string hint, list;
-      std::size_t best = 3;
-      for (const auto& kk : known) {
-        const std::size_t d = yaml::edit_distance(k, kk);
-        if (d < best) {
-          best = d;
-          hint = kk;
-        }
-        list += (list.empty() ? "" : ", ") + kk;
-      }
-      errors.add(fmt::format("{}: {}: unknown key{}; expected one of: {}",
-                             where_of(label, it->first), path,
-                             hint.empty() ? "" : " (did you mean '" + hint + "'?)", list));
-    }
-  };
-  if (!root.IsMap()) {
-    errors.add(fmt::format("{}: got {}, expected a JSON object with a \"metrics\" list", label,
-                           yaml::describe_node(root)));
-    errors.throw_if_any();
-  }
-  unknown_keys(root, "", {"description", "metrics"});
-  if (const YAML::Node d = root["description"]; d) {
-    if (d.IsScalar())
-      b.description = d.Scalar();
-    else
-      fail(d, "description", yaml::describe_node(d), "a string");
-  }
-  const YAML::Node metrics = root["metrics"];
-  if (!metrics) {
-    errors.add(
-        fmt::format("{}: metrics: missing, expected a list of {{\"key\": ..., "
-                    "\"baseline\": ..., \"direction\": ..., \"abs_tol\": ..., "
-                    "\"rel_tol\": ...}}",
-                    label));
-  } else if (!metrics.IsSequence() || metrics.size() == 0) {
-    fail(metrics, "metrics", metrics.IsSequence() ? "an empty list" : yaml::describe_node(metrics),
-         "a list of at least one metric");
-  } else {
-    std::set<std::string> keys;
-    for (std::size_t i = 0; i < metrics.size(); ++i) {
-      const YAML::Node e = metrics[i];
-      const std::string path = fmt::format("metrics[{}]", i);
-      if (!e.IsMap()) {
-        fail(e, path, yaml::describe_node(e), "an object {\"key\": ..., \"baseline\": ...}");
-        continue;
-      }
-      unknown_keys(e, path, {"key", "baseline", "direction", "abs_tol", "rel_tol"});
-      BaselineMetric m;
-      m.where = where_of(label, e);
-      const YAML::Node key = e["key"];
-      if (!key) {
-        errors.add(
-            fmt::format("{}: {}.key: missing, expected a metrics.json key path such as "
-                        "algorithms.sparse.ape.trans_m.rmse",
-                        m.where, path));
-      } else if (!key.IsScalar() || key.Scalar().empty()) {
-        fail(key, path + ".key", yaml::describe_node(key), "a metrics.json key path");
-      } else {
-        m.key = key.Scalar();
-        if (!keys.insert(m.key).second)
-          fail(key, path + ".key", "'" + m.key + "' again", "each key once");
-      }
-      auto number = [&](const char* name, bool non_negative) -> std::optional<double> {
-        const YAML::Node n = e[name];
-        if (!n || n.IsNull()) return std::nullopt;
-        double v = 0;
-        if (!n.IsScalar() || !yaml::parse_double(n.Scalar(), &v) || !std::isfinite(v)) {
-          fail(n, path + "." + name, yaml::describe_node(n), "a finite number");
-          return std::nullopt;
-        }
-        if (non_negative && v < 0) {
-          fail(n, path + "." + name, yaml::describe_node(n), "a number >= 0");
-          return std::nullopt;
-        }
-        return v;
-      };
-      m.baseline = number("baseline", false);
-      m.abs_tol = number("abs_tol", true).value_or(0.0);
-      m.rel_tol = number("rel_tol", true).value_or(0.0);
-      if (const YAML::Node d = e["direction"]; d) {
-        std::optional<MetricDirection> dir;
-        if (d.IsScalar()) dir = yaml::enum_from_name<MetricDirection>(d.Scalar());
-        if (!dir)
-          fail(d, path + ".direction", yaml::describe_node(d),
-               "one of: lower (lower is better), higher (higher is better), both (no change "
-               "beyond the tolerance)");
-        else
-          m.direction = *dir;
-      }
-      b.metrics.push_back(std::move(m));
-    }
+  // Each key once (a rule across the entries).
+  yaml::ErrorList errors;
+  std::set<std::string> keys;
+  for (std::size_t i = 0; i < b.metrics.size(); ++i) {
+    const BaselineMetric& m = b.metrics[i];
+    if (!keys.insert(m.key).second)
+      errors.add(fmt::format("{}: metrics[{}].key: got '{}' again, expected each key once",
+                             m.key_where, i, m.key));
   }
   errors.throw_if_any();
   return b;
+}
+
+std::string baseline_reference_markdown() {
+  return yaml::schema_markdown(yaml::schema_of(Baseline{}));
 }
 
 std::string baseline_json(const Baseline& b) {

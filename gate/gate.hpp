@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include "core/yaml_io.hpp"
+
 namespace driftlab::gate {
 
 enum class MetricDirection { kLower, kHigher, kBoth };
@@ -33,26 +35,62 @@ constexpr auto enum_table(MetricDirection) {
                     std::pair{MetricDirection::kBoth, "both"}};
 }
 
+/// One gated metric of a baseline file.
 struct BaselineMetric {
   std::string key;
   std::optional<double> baseline;  // absent: not yet recorded (run with --update)
   MetricDirection direction = MetricDirection::kLower;
   double abs_tol = 0;
   double rel_tol = 0;
-  std::string where;  // FILE:LINE:COL of the entry
+  std::string where;      // FILE:LINE:COL of the entry
+  std::string key_where;  // FILE:LINE:COL of its key
   double tolerance() const;
+
+  template <class A>
+  void visit(A& a) {
+    a.location(&where);
+    a.location("key", &key_where);
+    a("key", key,
+      "A metrics.json key path (dotted, e.g. algorithms.sparse.ape.trans_m.rmse), or a JSON "
+      "pointer (/a/b.c/0) for keys that hold dots",
+      yaml::non_empty() & yaml::required("a metrics.json key path such as "
+                                         "algorithms.sparse.ape.trans_m.rmse"));
+    a("baseline", baseline,
+      "The accepted value (null: not recorded yet; `driftlab regress --update` writes it)",
+      yaml::expecting("a finite number"));
+    a("direction", direction,
+      "lower: lower is better (an increase beyond the tolerance is a regression); higher: "
+      "higher is better; both: any change beyond the tolerance is one");
+    a("abs_tol", abs_tol, "Absolute tolerance; the tolerance is max(abs_tol, rel_tol * |baseline|)",
+      yaml::non_negative() & yaml::expecting("a number >= 0"));
+    a("rel_tol", rel_tol, "Relative tolerance, a fraction of |baseline|",
+      yaml::non_negative() & yaml::expecting("a number >= 0"));
+  }
 };
 
+/// A baseline file, read by the strict reader like scenarios and sweeps.
 struct Baseline {
   std::filesystem::path file;
   std::string description;
   std::vector<BaselineMetric> metrics;
+
+  template <class A>
+  void visit(A& a) {
+    a("description", description, "What this gate protects, in words");
+    a("metrics", metrics, "The gated metrics",
+      yaml::required("a list of {\"key\": ..., \"baseline\": ..., \"direction\": ..., "
+                     "\"abs_tol\": ..., \"rel_tol\": ...}"));
+    a.require(!metrics.empty(), "metrics", "a list of at least one metric");
+  }
 };
 
 /// Reads a baseline file. Throws UserError naming file, line, field, value and
 /// what was expected (unknown keys, wrong types, negative tolerances, an empty
 /// metrics list, duplicate keys).
 Baseline load_baseline(const std::filesystem::path& file);
+/// The reference of every baseline key (Markdown), generated from the reader's own field list:
+/// `driftlab regress schema`, docs/baseline-reference.md.
+std::string baseline_reference_markdown();
 
 /// The baseline as JSON text (what --update writes).
 std::string baseline_json(const Baseline& b);

@@ -85,6 +85,9 @@ Sweep load_sweep(const std::filesystem::path& file);
 /// The same from text; `label` names it in messages, relative paths resolve against `dir`.
 Sweep parse_sweep(const std::string& text, const std::string& label,
                   const std::filesystem::path& dir);
+/// The reference of every sweep-file key (Markdown), generated from the reader's own field
+/// list: `driftlab sweep schema`, docs/sweep-reference.md.
+std::string sweep_reference_markdown();
 
 /// One run of the sweep.
 struct SweepJob {

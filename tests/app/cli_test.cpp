@@ -116,6 +116,24 @@ TEST(Cli, SchemaReferenceInDocsIsUpToDate) {
   fs::remove_all(dir);
 }
 
+// The sweep-file and baseline references come from the same visit() lists as their readers.
+TEST(Cli, SweepAndBaselineReferencesInDocsAreUpToDate) {
+  const fs::path dir = fresh_temp_dir("schema");
+  const std::pair<std::vector<std::string>, std::string> refs[] = {
+      {{"sweep", "schema"}, "docs/sweep-reference.md"},
+      {{"regress", "schema"}, "docs/baseline-reference.md"}};
+  for (const auto& [args, doc] : refs) {
+    std::vector<std::string> cmd = args;
+    cmd.insert(cmd.end(), {"--out", (dir / "ref.md").string()});
+    const Result r = run_cli(cmd);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(read_text(dir / "ref.md"), read_text(kSource / doc))
+        << doc << " is stale: run `build/bin/driftlab " << args[0] << " schema --out " << doc
+        << "`";
+  }
+  fs::remove_all(dir);
+}
+
 TEST(Cli, RunWritesAtomicallyAndRefusesToOverwrite) {
   const fs::path dir = fresh_temp_dir("run");
   const std::string file = (kSource / "scenarios/river_crossing.yaml").string();

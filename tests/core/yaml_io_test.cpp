@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <optional>
 #include <random>
 
 namespace driftlab::yaml {
@@ -286,6 +287,164 @@ TEST(YamlSchema, OneRowPerFieldWithDefaultsAndConstraints) {
   EXPECT_EQ(find("hi")->constraint, "hi > lo");
   EXPECT_NE(schema_markdown(rows).find("| `inner.x_m` | number | `1.5` | > 0 |"),
             std::string::npos);
+}
+
+// ---------------------------------------------------------------------------
+// Optional, required, one-of, free-form values and mappings, locations: what sweep files and
+// baselines need from the one strict reader.
+
+struct Span {
+  double start = 0;
+  std::optional<double> step;
+  std::string where;
+  template <class A>
+  void visit(A& a) {
+    a.location(&where);
+    a("start", start, "Start", required("a number"));
+    a("step", step, "Step", positive() & expecting("a step > 0"));
+  }
+};
+
+struct Spec {
+  std::string key;
+  std::optional<std::string> label;
+  std::optional<std::vector<Any>> values;
+  std::optional<Span> span;
+  Entries<Any> set;
+  std::uint64_t copies = 1;
+  std::string where, key_where;
+  template <class A>
+  void visit(A& a) {
+    a.location(&where);
+    a.location("key", &key_where);
+    a("key", key, "A key path", non_empty() & required("a key path such as a.b"));
+    a("label", label, "A label", non_empty());
+    a("values", values, "Values as written");
+    a("span", span, "A generated span");
+    a("set", set, "Fixed values by key path", expecting("a mapping of key paths to values"));
+    a("copies", copies, "Copies", expecting("an integer >= 1 (copies)"));
+    a.exactly_one_of({"values", "span"});
+    a.require(!values || !values->empty(), "values", "at least one value");
+    a.require(copies >= 1, "copies", "an integer >= 1 (copies)");
+  }
+};
+
+Spec read_spec(const std::string& text) {
+  Spec s;
+  read_into(load_string(text, "spec.yaml"), {"spec.yaml", true}, &s);
+  return s;
+}
+
+std::string spec_error(const std::string& text) {
+  try {
+    read_spec(text);
+  } catch (const UserError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(YamlReader, OptionalAnyAndEntriesReadAsWrittenWithTheirPlaces) {
+  const Spec s =
+      read_spec("key: a.b\nvalues: [1, [x, y], {m: 2}]\nset:\n  p.q: 3\n  r: [1, 2]\ncopies: 2\n");
+  EXPECT_EQ(s.key, "a.b");
+  EXPECT_EQ(s.key_where, "spec.yaml:1:6");
+  EXPECT_EQ(s.where, "spec.yaml:1:1");
+  EXPECT_FALSE(s.label.has_value());
+  EXPECT_FALSE(s.span.has_value());
+  ASSERT_TRUE(s.values.has_value());
+  ASSERT_EQ(s.values->size(), 3u);
+  EXPECT_EQ((*s.values)[0].flow_text(), "1");
+  EXPECT_EQ((*s.values)[1].flow_text(), "[x, y]");
+  EXPECT_EQ((*s.values)[2].flow_text(), "{m: 2}");
+  EXPECT_EQ((*s.values)[1].where, "spec.yaml:2:13");
+  ASSERT_EQ(s.set.size(), 2u);
+  EXPECT_EQ(s.set[0].key, "p.q");
+  EXPECT_EQ(s.set[0].value.flow_text(), "3");
+  EXPECT_EQ(s.set[0].where, "spec.yaml:4:3");
+  EXPECT_EQ(s.set[1].key, "r");
+  EXPECT_EQ(s.set[1].value.flow_text(), "[1, 2]");
+  EXPECT_EQ(s.copies, 2u);
+
+  const Spec t = read_spec("key: k\nlabel: L\nspan: {start: 2.5, step: 0.5}\n");
+  EXPECT_EQ(t.label, "L");
+  ASSERT_TRUE(t.span.has_value());
+  EXPECT_EQ(t.span->start, 2.5);
+  EXPECT_EQ(t.span->step, 0.5);
+  EXPECT_EQ(t.span->where, "spec.yaml:3:7");
+  // Null is "not given".
+  EXPECT_FALSE(read_spec("key: k\nlabel: ~\nvalues: [1]\n").label.has_value());
+}
+
+TEST(YamlReader, RequiredOneOfAndRulesNameWhatIsExpected) {
+  // A missing top-level key has no place but the file; a nested one points at its mapping.
+  std::string e = spec_error("values: [1]\n");
+  EXPECT_NE(e.find("spec.yaml: key: missing, expected a key path such as a.b"), std::string::npos)
+      << e;
+  e = spec_error("key: k\nspan: {step: 1}\n");
+  EXPECT_NE(e.find("spec.yaml:2:7: span.start: missing, expected a number"), std::string::npos)
+      << e;
+  // Exactly one of: none, and two.
+  e = spec_error("key: k\n");
+  EXPECT_NE(e.find("spec.yaml:1:1: (top level): got none of values, span, expected exactly one "
+                   "of them"),
+            std::string::npos)
+      << e;
+  e = spec_error("key: k\nvalues: [1]\nspan: {start: 0}\n");
+  EXPECT_NE(e.find("spec.yaml:3:7: (top level): got both values and span, expected exactly one "
+                   "of: values, span"),
+            std::string::npos)
+      << e;
+  // Rules quote the value given (and say what an empty list is).
+  e = spec_error("key: k\nvalues: []\ncopies: 0\n");
+  EXPECT_NE(e.find("spec.yaml:2:9: values: got an empty list, expected at least one value"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("spec.yaml:3:9: copies: got '0', expected an integer >= 1 (copies)"),
+            std::string::npos)
+      << e;
+  // Custom wording replaces the generated text, for types and bounds alike.
+  e = spec_error("key: k\nvalues: [1]\ncopies: -2\nset: [1]\n");
+  EXPECT_NE(e.find("copies: got '-2', expected an integer >= 1 (copies)"), std::string::npos) << e;
+  EXPECT_NE(e.find("set: got a list, expected a mapping of key paths to values"), std::string::npos)
+      << e;
+  e = spec_error("key: k\nspan: {start: 0, step: -1}\n");
+  EXPECT_NE(e.find("span.step: got '-1', expected a step > 0"), std::string::npos) << e;
+  // A value that does not read is not there: no rule fires on a half-read value.
+  e = spec_error("key: k\nvalues: 3\n");
+  EXPECT_NE(e.find("values: got '3', expected a list"), std::string::npos) << e;
+  EXPECT_EQ(e.find("at least one value"), std::string::npos) << e;
+  // A required key that is missing is reported once, not again by the rules about it.
+  e = spec_error("values: [1]\n");
+  EXPECT_EQ(e.find("\n"), std::string::npos) << e;
+  // Duplicate names in a free-form mapping.
+  e = spec_error("key: k\nvalues: [1]\nset: {a: 1, a: 2}\n");
+  EXPECT_NE(e.find("set.a: duplicate key, expected each key once"), std::string::npos) << e;
+}
+
+TEST(YamlSchema, OptionalEntriesAndOneOfAppearInTheReference) {
+  const auto rows = schema_of(Spec{});
+  auto row = [&](const std::string& key) {
+    for (const auto& r : rows)
+      if (r.key_path == key) return r;
+    ADD_FAILURE() << key;
+    return SchemaRow{};
+  };
+  EXPECT_EQ(row("key").constraint, "required, non-empty");
+  EXPECT_EQ(row("label").type, "string or null");
+  EXPECT_EQ(row("label").default_value, "null");
+  EXPECT_EQ(row("set").type, "mapping of names to any value");
+  EXPECT_EQ(row("set").default_value, "{}");
+  EXPECT_EQ(row("span").type, "mapping or null");
+  EXPECT_EQ(row("span.start").constraint, "required");
+  EXPECT_EQ(row("values").constraint, "exactly one of values, span; at least one value");
+  // The writer writes what it read.
+  const Spec s = read_spec("key: a\nvalues: [1, [2, 3]]\nset: {p: x}\n");
+  const Spec back = read_spec(to_yaml(s));
+  EXPECT_EQ(back.key, "a");
+  EXPECT_EQ((*back.values)[1].flow_text(), "[2, 3]");
+  EXPECT_EQ(back.set[0].value.flow_text(), "x");
+  EXPECT_FALSE(back.label.has_value());
 }
 
 TEST(YamlHelpers, EditDistance) {
