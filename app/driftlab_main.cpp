@@ -11,6 +11,7 @@
 
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -163,6 +164,164 @@ int eval_command(const EvalArgs& a) {
   return 0;
 }
 
+// The verbs declared here. CLI11 keeps the addresses of the variables it fills, so a verb is
+// built in place and never copied.
+struct Pinned {
+  Pinned() = default;
+  Pinned(const Pinned&) = delete;
+  Pinned& operator=(const Pinned&) = delete;
+};
+
+// scenario check / schema
+struct ScenarioVerbs : Pinned {
+  explicit ScenarioVerbs(CLI::App& app) {
+    auto* scenario_cmd = app.add_subcommand("scenario", "Validate and document scenario files");
+    scenario_cmd->require_subcommand(1);
+    check_cmd = scenario_cmd->add_subcommand(
+        "check", "Validate a scenario and print it resolved (every default filled in)");
+    check_cmd->add_option("FILE", check_file, "Scenario YAML file")->required();
+    check_cmd->add_option("--set", check_sets, "Override a key: KEY.PATH=VALUE (repeatable)");
+    check_cmd->add_flag("-q,--quiet", check_quiet, "Only validate; do not print the scenario");
+    schema_cmd = scenario_cmd->add_subcommand(
+        "schema", "Print the reference of every scenario key (Markdown)");
+    schema_cmd->add_option("--out", schema_out, "Write to this file instead of standard output");
+  }
+
+  std::optional<int> dispatch() const {
+    if (check_cmd->parsed()) return scenario_check(check_file, check_sets, check_quiet);
+    if (schema_cmd->parsed()) return scenario_schema(schema_out);
+    return std::nullopt;
+  }
+
+  CLI::App* check_cmd = nullptr;
+  std::string check_file;
+  std::vector<std::string> check_sets;
+  bool check_quiet = false;
+  CLI::App* schema_cmd = nullptr;
+  std::string schema_out;
+};
+
+// run (its sweep options, --manifest/--job/--shard, come from StudyCommands)
+struct RunVerb : Pinned {
+  explicit RunVerb(CLI::App& app) {
+    cmd = app.add_subcommand("run", "Run one scenario end to end into an output folder");
+    scenario_opt = cmd->add_option("SCENARIO", file, "Scenario YAML file");
+    out_opt = cmd->add_option("--out", out, "Output folder (written atomically)");
+    cmd->add_option("--set", sets, "Override a key: KEY.PATH=VALUE (repeatable)");
+    cmd->add_option("--seed", seed, "Override the scenario seed");
+    cmd->add_flag("--force", force, "Replace an existing output folder");
+    cmd->add_flag("--only-motion", only_motion,
+                  "Stop after the physics stage (body_groundtruth.csv, groundtruth.tum)");
+  }
+
+  std::optional<int> dispatch() const {
+    if (!cmd->parsed()) return std::nullopt;
+    return run_command(file, out, sets, seed, force, only_motion);
+  }
+
+  CLI::App* cmd = nullptr;
+  CLI::Option* scenario_opt = nullptr;
+  CLI::Option* out_opt = nullptr;
+  std::string file, out, seed;
+  std::vector<std::string> sets;
+  bool force = false;
+  bool only_motion = false;
+};
+
+// Subcommands whose stages land with later issues: their options are
+// declared so that --help documents them.
+struct RenderVerb : Pinned {
+  explicit RenderVerb(CLI::App& app) {
+    cmd = app.add_subcommand("render", "Render the stereo sequence of a scenario to PNG files");
+    cmd->add_option("SCENARIO", file, "Scenario YAML file")->required();
+    cmd->add_option("--out", out, "Output folder")->required();
+    cmd->add_option("--frames", frames, "Number of stereo frames (0 = all)");
+    cmd->add_flag("--depth", depth, "Also write ground-truth depth (depth/NNNNNN.pfm)");
+    cmd->add_option("--set", sets, "Override a key: KEY.PATH=VALUE (repeatable)");
+    cmd->add_flag("--force", force, "Replace an existing output folder");
+  }
+
+  std::optional<int> dispatch() const {
+    if (!cmd->parsed()) return std::nullopt;
+    const auto scenario = driftlab::pipeline::load_scenario(file, sets);
+    driftlab::pipeline::RenderSequenceOptions ro;
+    ro.max_frames = frames;
+    ro.depth = depth;
+    ro.replace_existing = force;
+    const auto summary = driftlab::pipeline::render_sequence(scenario, out, ro);
+    std::cout << summary.brief() << "\n";
+    return 0;
+  }
+
+  CLI::App* cmd = nullptr;
+  std::string file, out;
+  int frames = 0;
+  bool depth = false;
+  std::vector<std::string> sets;
+  bool force = false;
+};
+
+struct EvalVerb : Pinned {
+  explicit EvalVerb(CLI::App& app) {
+    cmd = app.add_subcommand(
+        "eval", "Evaluate a trajectory against ground truth (the papers' tables, APE/RPE, KITTI)");
+    cmd->add_option("--gt", ev.gt, "Ground-truth trajectory file")->required();
+    cmd->add_option("--est", ev.est, "Estimated trajectory file")->required();
+    cmd->add_option("--format", ev.format, "File format of both: tum, kitti or euroc")
+        ->capture_default_str();
+    cmd->add_option("--align", ev.align, "Alignment: horn, se3, sim3, posyaw or none")
+        ->capture_default_str();
+    cmd->add_option("--align-first-n", ev.align_first_n,
+                    "Align on the first N poses only (0 = all)");
+    cmd->add_option("--max-diff", ev.max_diff_s, "Largest stamp difference when pairing poses [s]")
+        ->capture_default_str();
+    cmd->add_option("--section-length", ev.section_length_m, "Section length [m]")
+        ->capture_default_str();
+    cmd->add_option("--length-sample", ev.length_sample_m,
+                    "Track lengths through one pose every this many metres of true travel "
+                    "(0 = every pose) [m]")
+        ->capture_default_str();
+    cmd->add_option("--rpe-delta", ev.rpe_delta, "RPE step")->capture_default_str();
+    cmd->add_option("--rpe-unit", ev.rpe_unit, "RPE step unit: frames or meters")
+        ->capture_default_str();
+    cmd->add_option("--covariates", ev.covariates,
+                    "Per-frame covariates CSV (t_ns or t column; inliers, mean_depth_m, ...)");
+    cmd->add_option("--regress", ev.regress, "Comma-separated regression covariates")
+        ->capture_default_str();
+    cmd->add_option("--name", ev.name, "Algorithm name in tables (default: estimate file stem)");
+    cmd->add_option("--out", ev.out, "Output folder (written atomically)")->required();
+    cmd->add_flag("--force", ev.force, "Replace an existing output folder");
+  }
+
+  std::optional<int> dispatch() const {
+    if (!cmd->parsed()) return std::nullopt;
+    return eval_command(ev);
+  }
+
+  CLI::App* cmd = nullptr;
+  EvalArgs ev;
+};
+
+struct PaperVerb : Pinned {
+  explicit PaperVerb(CLI::App& app) {
+    cmd = app.add_subcommand(
+        "paper", "The river paper's Tables 1-4 next to a run's (river_crossing, river_survey)");
+    cmd->add_option("RUN", run, "Run folder or its metrics.json")->required();
+    cmd->add_option("--track", track,
+                    "Row of the paper's Table 2: discharge (four crossings) or total (the "
+                    "survey); default: from the run's scenario name");
+    cmd->add_option("--out", out, "Write the Markdown to this file (default: stdout)");
+  }
+
+  std::optional<int> dispatch() const {
+    if (!cmd->parsed()) return std::nullopt;
+    return paper_command(run, track, out);
+  }
+
+  CLI::App* cmd = nullptr;
+  std::string run, track, out;
+};
+
 }  // namespace
 
 namespace driftlab::app {
@@ -172,123 +331,32 @@ int driftlab_main(int argc, char** argv) {
   app.set_version_flag("--version", std::string(DRIFTLAB_VERSION));
   app.require_subcommand(1);
 
-  // scenario check / schema
-  auto* scenario_cmd = app.add_subcommand("scenario", "Validate and document scenario files");
-  scenario_cmd->require_subcommand(1);
-  std::string check_file;
-  std::vector<std::string> check_sets;
-  bool check_quiet = false;
-  auto* check_cmd = scenario_cmd->add_subcommand(
-      "check", "Validate a scenario and print it resolved (every default filled in)");
-  check_cmd->add_option("FILE", check_file, "Scenario YAML file")->required();
-  check_cmd->add_option("--set", check_sets, "Override a key: KEY.PATH=VALUE (repeatable)");
-  check_cmd->add_flag("-q,--quiet", check_quiet, "Only validate; do not print the scenario");
-  std::string schema_out;
-  auto* schema_cmd = scenario_cmd->add_subcommand(
-      "schema", "Print the reference of every scenario key (Markdown)");
-  schema_cmd->add_option("--out", schema_out, "Write to this file instead of standard output");
-
-  // run
-  std::string run_file, run_out, run_seed;
-  std::vector<std::string> run_sets;
-  bool run_force = false;
-  auto* run_cmd = app.add_subcommand("run", "Run one scenario end to end into an output folder");
-  auto* run_scenario_opt = run_cmd->add_option("SCENARIO", run_file, "Scenario YAML file");
-  auto* run_out_opt = run_cmd->add_option("--out", run_out, "Output folder (written atomically)");
-  run_cmd->add_option("--set", run_sets, "Override a key: KEY.PATH=VALUE (repeatable)");
-  run_cmd->add_option("--seed", run_seed, "Override the scenario seed");
-  run_cmd->add_flag("--force", run_force, "Replace an existing output folder");
-  bool run_only_motion = false;
-  run_cmd->add_flag("--only-motion", run_only_motion,
-                    "Stop after the physics stage (body_groundtruth.csv, groundtruth.tum)");
-
-  // Subcommands whose stages land with later issues: their options are
-  // declared so that --help documents them.
-  std::string render_file, render_out;
-  int render_frames = 0;
-  bool render_depth = false;
-  auto* render_cmd =
-      app.add_subcommand("render", "Render the stereo sequence of a scenario to PNG files");
-  render_cmd->add_option("SCENARIO", render_file, "Scenario YAML file")->required();
-  render_cmd->add_option("--out", render_out, "Output folder")->required();
-  render_cmd->add_option("--frames", render_frames, "Number of stereo frames (0 = all)");
-  render_cmd->add_flag("--depth", render_depth, "Also write ground-truth depth (depth/NNNNNN.pfm)");
-  std::vector<std::string> render_sets;
-  render_cmd->add_option("--set", render_sets, "Override a key: KEY.PATH=VALUE (repeatable)");
-  bool render_force = false;
-  render_cmd->add_flag("--force", render_force, "Replace an existing output folder");
-
-  EvalArgs ev;
-  auto* eval_cmd = app.add_subcommand(
-      "eval", "Evaluate a trajectory against ground truth (the papers' tables, APE/RPE, KITTI)");
-  eval_cmd->add_option("--gt", ev.gt, "Ground-truth trajectory file")->required();
-  eval_cmd->add_option("--est", ev.est, "Estimated trajectory file")->required();
-  eval_cmd->add_option("--format", ev.format, "File format of both: tum, kitti or euroc")
-      ->capture_default_str();
-  eval_cmd->add_option("--align", ev.align, "Alignment: horn, se3, sim3, posyaw or none")
-      ->capture_default_str();
-  eval_cmd->add_option("--align-first-n", ev.align_first_n,
-                       "Align on the first N poses only (0 = all)");
-  eval_cmd
-      ->add_option("--max-diff", ev.max_diff_s, "Largest stamp difference when pairing poses [s]")
-      ->capture_default_str();
-  eval_cmd->add_option("--section-length", ev.section_length_m, "Section length [m]")
-      ->capture_default_str();
-  eval_cmd
-      ->add_option("--length-sample", ev.length_sample_m,
-                   "Track lengths through one pose every this many metres of true travel "
-                   "(0 = every pose) [m]")
-      ->capture_default_str();
-  eval_cmd->add_option("--rpe-delta", ev.rpe_delta, "RPE step")->capture_default_str();
-  eval_cmd->add_option("--rpe-unit", ev.rpe_unit, "RPE step unit: frames or meters")
-      ->capture_default_str();
-  eval_cmd->add_option("--covariates", ev.covariates,
-                       "Per-frame covariates CSV (t_ns or t column; inliers, mean_depth_m, ...)");
-  eval_cmd->add_option("--regress", ev.regress, "Comma-separated regression covariates")
-      ->capture_default_str();
-  eval_cmd->add_option("--name", ev.name, "Algorithm name in tables (default: estimate file stem)");
-  eval_cmd->add_option("--out", ev.out, "Output folder (written atomically)")->required();
-  eval_cmd->add_flag("--force", ev.force, "Replace an existing output folder");
-
-  std::string paper_run, paper_track, paper_out;
-  auto* paper_cmd = app.add_subcommand(
-      "paper", "The river paper's Tables 1-4 next to a run's (river_crossing, river_survey)");
-  paper_cmd->add_option("RUN", paper_run, "Run folder or its metrics.json")->required();
-  paper_cmd->add_option("--track", paper_track,
-                        "Row of the paper's Table 2: discharge (four crossings) or total (the "
-                        "survey); default: from the run's scenario name");
-  paper_cmd->add_option("--out", paper_out, "Write the Markdown to this file (default: stdout)");
+  const ScenarioVerbs scenario_verbs(app);
+  const RunVerb run_verb(app);
+  const RenderVerb render_verb(app);
+  const EvalVerb eval_verb(app);
+  const PaperVerb paper_verb(app);
 
   // export, vo: datasets out and in.
   driftlab::app::DatasetCommands dataset_commands(app);
 
   // sweep plan|run|status|merge|slurm-script, and run --manifest/--job/--shard.
   driftlab::app::StudyCommands study_commands(app);
-  study_commands.add_run_options(run_cmd, run_scenario_opt, run_out_opt, &run_force);
+  study_commands.add_run_options(run_verb.cmd, run_verb.scenario_opt, run_verb.out_opt,
+                                 &run_verb.force);
   // regress: the CI baseline gate (also built alone as driftlab-gate).
   driftlab::app::GateCommand gate_command(app.add_subcommand(
       "regress", "Compare metrics with a baseline (CI regression gate); exit 5 on a regression"));
 
   return driftlab::app::run_cli_main(app, argc, argv, [&]() -> int {
-    if (check_cmd->parsed()) return scenario_check(check_file, check_sets, check_quiet);
-    if (schema_cmd->parsed()) return scenario_schema(schema_out);
+    if (const auto rc = scenario_verbs.dispatch()) return *rc;
     if (const auto rc = study_commands.dispatch()) return *rc;
     if (const auto rc = dataset_commands.dispatch()) return *rc;
     if (const auto rc = gate_command.dispatch()) return *rc;
-    if (run_cmd->parsed())
-      return run_command(run_file, run_out, run_sets, run_seed, run_force, run_only_motion);
-    if (render_cmd->parsed()) {
-      const auto scenario = driftlab::pipeline::load_scenario(render_file, render_sets);
-      driftlab::pipeline::RenderSequenceOptions ro;
-      ro.max_frames = render_frames;
-      ro.depth = render_depth;
-      ro.replace_existing = render_force;
-      const auto summary = driftlab::pipeline::render_sequence(scenario, render_out, ro);
-      std::cout << summary.brief() << "\n";
-      return 0;
-    }
-    if (eval_cmd->parsed()) return eval_command(ev);
-    if (paper_cmd->parsed()) return paper_command(paper_run, paper_track, paper_out);
+    if (const auto rc = run_verb.dispatch()) return *rc;
+    if (const auto rc = render_verb.dispatch()) return *rc;
+    if (const auto rc = eval_verb.dispatch()) return *rc;
+    if (const auto rc = paper_verb.dispatch()) return *rc;
     return 0;
   });
 }

@@ -503,29 +503,45 @@ void require_finite(const OlsResult& res) {
         "squares; rescale y or the columns (e.g. change units)");
 }
 
-}  // namespace
+// The problem ols() factorises: the columns centred (with an intercept) and scaled to unit norm,
+// and y centred and scaled to unit norm.
+struct ScaledProblem {
+  MatrixXd z;            // unit-norm (centred) regressors
+  VectorXd xbar, scale;  // the columns' means and norms after centring
+  double ybar = 0;       // mean of y (0 without an intercept)
+  VectorXd ys;           // (y - ybar) / sy
+  double sy = 0;         // norm of y - ybar
+};
 
-OlsResult ols(const std::vector<double>& y, const std::vector<std::vector<double>>& columns,
-              const std::vector<std::string>& names, const OlsOptions& options) {
-  check_inputs(y, columns, names, options);
-  const bool with_intercept = options.intercept;
+// Centring removes the intercept from the factorisation (Frisch-Waugh) and, with unit-norm
+// columns, leaves the QR the conditioning of the regressors' correlations rather than of their
+// offsets and units: Longley's raw design has condition number 4.9e9, unit-norm columns 4.3e4,
+// centred unit-norm columns 111.
+ScaledProblem scale_problem(const std::vector<double>& y,
+                            const std::vector<std::vector<double>>& columns, bool with_intercept) {
   const Index n = static_cast<Index>(y.size());
-  const Index k = static_cast<Index>(columns.size());
-  const Index params = k + (with_intercept ? 1 : 0);
-  const Index df_resid = n - params;
+  ScaledProblem p;
+  p.z = unit_columns(columns, with_intercept, &p.xbar, &p.scale);
+  p.ybar = with_intercept ? mean_of(y) : 0.0;
+  p.ys.resize(n);
+  for (Index i = 0; i < n; ++i) p.ys(i) = y[static_cast<std::size_t>(i)] - p.ybar;
+  p.sy = p.ys.stableNorm();
+  p.ys /= p.sy;  // scale-free from here on; sums of squares cannot overflow
+  return p;
+}
 
-  // Centring removes the intercept from the factorisation (Frisch-Waugh) and, with unit-norm
-  // columns, leaves the QR the conditioning of the regressors' correlations rather than of their
-  // offsets and units: Longley's raw design has condition number 4.9e9, unit-norm columns 4.3e4,
-  // centred unit-norm columns 111.
-  VectorXd xbar, scale;
-  const MatrixXd z = unit_columns(columns, with_intercept, &xbar, &scale);
-  const double ybar = with_intercept ? mean_of(y) : 0.0;
-  VectorXd ys(n);
-  for (Index i = 0; i < n; ++i) ys(i) = y[static_cast<std::size_t>(i)] - ybar;
-  const double sy = ys.stableNorm();
-  ys /= sy;  // scale-free from here on; sums of squares cannot overflow
+// The pivoted QR of the unit-norm design and what its R tells of the conditioning.
+struct Factorisation {
+  Eigen::ColPivHouseholderQR<MatrixXd> qr;
+  MatrixXd r;        // the k x k upper triangle of the QR
+  double condition;  // largest over smallest singular value of the design
+  VectorXd weakest;  // the design's weakest direction (smallest right singular vector)
+};
 
+// Throws UserError when the columns are exactly collinear.
+Factorisation factorise(const MatrixXd& z, const std::vector<std::string>& names,
+                        bool with_intercept) {
+  const Index n = z.rows(), k = z.cols();
   Eigen::ColPivHouseholderQR<MatrixXd> qr(n, k);
   qr.setThreshold(kRankTolerance);
   qr.compute(z);
@@ -543,11 +559,24 @@ OlsResult ols(const std::vector<double>& y, const std::vector<std::vector<double
         "{:.3g}); drop one of them",
         quoted_list(weakest_direction_columns(weakest, names)),
         with_intercept ? " (together with the intercept)" : "", k, qr.rank(), condition));
+  return {qr, r, condition, weakest};
+}
 
+// M = P R^-1 and the regressors' variance inflation factors from it.
+struct VarianceFactors {
+  MatrixXd m;
+  VectorXd vif;
+  Index worst = 0;  // the regressor with the largest VIF
+};
+
+// Throws UserError when a VIF is above options.collinearity_vif.
+VarianceFactors variance_factors(const Factorisation& f, const std::vector<std::string>& names,
+                                 const OlsOptions& options) {
+  const Index k = f.r.rows();
   // M = P R^-1: (Z'Z)^-1 = M M', so row j of M gives regressor j's variance factor (its VIF,
   // since Z'Z is the correlation matrix when centred) without ever forming Z'Z.
-  const MatrixXd r_inv = r.triangularView<Eigen::Upper>().solve(MatrixXd::Identity(k, k));
-  const MatrixXd m = qr.colsPermutation() * r_inv;
+  const MatrixXd r_inv = f.r.triangularView<Eigen::Upper>().solve(MatrixXd::Identity(k, k));
+  const MatrixXd m = f.qr.colsPermutation() * r_inv;
   VectorXd vif(k);
   for (Index j = 0; j < k; ++j) vif(j) = m.row(j).squaredNorm();
   Index worst = 0;
@@ -557,35 +586,57 @@ OlsResult ols(const std::vector<double>& y, const std::vector<std::vector<double
         "ols: columns {} are nearly collinear: VIF of '{}' is {:.3g} (1 - R^2 = {:.2g} on the "
         "other regressors), above collinearity_vif = {:.3g}; condition number {:.3g}. Drop or "
         "combine one of them",
-        quoted_list(weakest_direction_columns(weakest, names)),
+        quoted_list(weakest_direction_columns(f.weakest, names)),
         names[static_cast<std::size_t>(worst)], vif(worst), 1.0 / vif(worst),
-        options.collinearity_vif, condition));
+        options.collinearity_vif, f.condition));
+  return {m, vif, worst};
+}
 
-  const VectorXd qty = qr.householderQ().transpose() * ys;
-  const VectorXd b = m * qty.head(k);  // coefficients of the unit-norm problem
-  const double rss_s = qty.tail(n - k).squaredNorm();
-  const double ess_s = qty.head(k).squaredNorm();
-  const double tss_s = ys.squaredNorm();
+// The least-squares solution of the unit-norm problem and its sums of squares.
+struct ScaledFit {
+  VectorXd b;  // coefficients of the unit-norm problem
+  double rss_s = 0, ess_s = 0, tss_s = 0;
+  bool perfect = false;  // residuals are rounding noise of exact data
+  double sigma_s = 0;
+  VectorXd e_s;  // residuals (zero on a perfect fit)
+};
+
+ScaledFit fit_scaled(const Factorisation& f, const VarianceFactors& v, const VectorXd& ys,
+                     Index df_resid) {
+  const Index n = ys.size(), k = f.r.rows();
+  ScaledFit fit;
+  const VectorXd qty = f.qr.householderQ().transpose() * ys;
+  fit.b = v.m * qty.head(k);  // coefficients of the unit-norm problem
+  fit.rss_s = qty.tail(n - k).squaredNorm();
+  fit.ess_s = qty.head(k).squaredNorm();
+  fit.tss_s = ys.squaredNorm();
   // Residuals within 1e-12 of the response's spread are what rounding of exact data leaves
   // behind; the fit is then treated as exact (NIST certifies Wampler1's standard deviations
   // as 0) rather than reporting t ~ 1e16 that measures the arithmetic.
-  const bool perfect = rss_s <= kPerfectFitRss * tss_s;
-  const double sigma_s = perfect ? 0.0 : std::sqrt(rss_s / static_cast<double>(df_resid));
+  fit.perfect = fit.rss_s <= kPerfectFitRss * fit.tss_s;
+  fit.sigma_s = fit.perfect ? 0.0 : std::sqrt(fit.rss_s / static_cast<double>(df_resid));
 
   // Residuals as the projection onto the complement of the column space: consistent with rss
   // to rounding, unlike y - X beta, which cancels.
-  VectorXd e_s = VectorXd::Zero(n);
-  if (!perfect) {
-    e_s.tail(n - k) = qty.tail(n - k);
-    e_s = qr.householderQ() * e_s;
+  fit.e_s = VectorXd::Zero(n);
+  if (!fit.perfect) {
+    fit.e_s.tail(n - k) = qty.tail(n - k);
+    fit.e_s = f.qr.householderQ() * fit.e_s;
   }
+  return fit;
+}
 
-  OlsResult res;
-  res.n = static_cast<std::size_t>(n);
-  res.df_model = static_cast<std::size_t>(k);
-  res.df_resid = static_cast<std::size_t>(df_resid);
-  res.intercept = with_intercept;
-  res.alpha = options.alpha;
+// The coefficients in the units of the data: the intercept first (if any), then the columns.
+std::vector<OlsCoefficient> coefficients(const ScaledProblem& p, const VarianceFactors& v,
+                                         const ScaledFit& fit,
+                                         const std::vector<std::string>& names,
+                                         const OlsOptions& options, Index df_resid) {
+  const bool with_intercept = options.intercept;
+  const bool perfect = fit.perfect;
+  const Index n = p.ys.size(), k = v.vif.size();
+  const VectorXd& b = fit.b;
+  const double sy = p.sy, sigma_s = fit.sigma_s;
+  std::vector<OlsCoefficient> out;
 
   // On a perfect fit a coefficient is either exactly determined and nonzero (t = +-inf) or
   // zero up to the same rounding that was forgiven in the residuals (t = 0).
@@ -602,53 +653,81 @@ OlsResult ols(const std::vector<double>& y, const std::vector<std::vector<double
       c.t = t;
     c.p = t_two_sided_p(c.t, static_cast<double>(df_resid));
     c.significant = c.p < options.alpha;
-    res.coefficients.push_back(std::move(c));
+    out.push_back(std::move(c));
   };
   const double negligible_scaled = std::sqrt(kPerfectFitRss);
 
   std::vector<double> beta(static_cast<std::size_t>(k));
-  for (Index j = 0; j < k; ++j) beta[static_cast<std::size_t>(j)] = sy * b(j) / scale(j);
+  for (Index j = 0; j < k; ++j) beta[static_cast<std::size_t>(j)] = sy * b(j) / p.scale(j);
   if (with_intercept) {
     // Var(b0) = sigma^2 (1/n + xbar' (Xc'Xc)^-1 xbar), the quadratic form as a squared norm.
-    const VectorXd w = xbar.cwiseQuotient(scale);
+    const VectorXd w = p.xbar.cwiseQuotient(p.scale);
     const double factor =
-        std::sqrt(1.0 / static_cast<double>(n) + (m.transpose() * w).squaredNorm());
-    double b0 = ybar;
-    double magnitude = std::abs(ybar) + sy / std::sqrt(static_cast<double>(n));
+        std::sqrt(1.0 / static_cast<double>(n) + (v.m.transpose() * w).squaredNorm());
+    double b0 = p.ybar;
+    double magnitude = std::abs(p.ybar) + sy / std::sqrt(static_cast<double>(n));
     for (Index j = 0; j < k; ++j) {
-      b0 -= beta[static_cast<std::size_t>(j)] * xbar(j);
-      magnitude += std::abs(beta[static_cast<std::size_t>(j)] * xbar(j));
+      b0 -= beta[static_cast<std::size_t>(j)] * p.xbar(j);
+      magnitude += std::abs(beta[static_cast<std::size_t>(j)] * p.xbar(j));
     }
     const double se0 = sy * sigma_s * factor;
     add_coefficient(kInterceptName, b0, se0, perfect ? 0.0 : b0 / se0,
                     std::abs(b0) <= negligible_scaled * magnitude, 0.0);
   }
   for (Index j = 0; j < k; ++j) {
-    const double factor = m.row(j).norm();
+    const double factor = v.m.row(j).norm();
     add_coefficient(names[static_cast<std::size_t>(j)], beta[static_cast<std::size_t>(j)],
-                    sy * sigma_s * factor / scale(j), perfect ? 0.0 : b(j) / (sigma_s * factor),
-                    std::abs(b(j)) <= negligible_scaled, vif(j));
+                    sy * sigma_s * factor / p.scale(j), perfect ? 0.0 : b(j) / (sigma_s * factor),
+                    std::abs(b(j)) <= negligible_scaled, v.vif(j));
   }
+  return out;
+}
+
+}  // namespace
+
+OlsResult ols(const std::vector<double>& y, const std::vector<std::vector<double>>& columns,
+              const std::vector<std::string>& names, const OlsOptions& options) {
+  check_inputs(y, columns, names, options);
+  const bool with_intercept = options.intercept;
+  const Index n = static_cast<Index>(y.size());
+  const Index k = static_cast<Index>(columns.size());
+  const Index params = k + (with_intercept ? 1 : 0);
+  const Index df_resid = n - params;
+
+  const ScaledProblem p = scale_problem(y, columns, with_intercept);
+  const Factorisation f = factorise(p.z, names, with_intercept);
+  const VarianceFactors v = variance_factors(f, names, options);
+  const ScaledFit fit = fit_scaled(f, v, p.ys, df_resid);
+  const bool perfect = fit.perfect;
+  const double sy = p.sy, rss_s = fit.rss_s, tss_s = fit.tss_s;
+
+  OlsResult res;
+  res.n = static_cast<std::size_t>(n);
+  res.df_model = static_cast<std::size_t>(k);
+  res.df_resid = static_cast<std::size_t>(df_resid);
+  res.intercept = with_intercept;
+  res.alpha = options.alpha;
+  res.coefficients = coefficients(p, v, fit, names, options, df_resid);
 
   res.rss = perfect ? 0.0 : sy * sy * rss_s;
   res.tss = sy * sy * tss_s;
-  res.sigma = sy * sigma_s;
+  res.sigma = sy * fit.sigma_s;
   res.r2 = perfect ? 1.0 : std::clamp(1.0 - rss_s / tss_s, 0.0, 1.0);
   res.adj_r2 = 1.0 - (1.0 - res.r2) * static_cast<double>(n - (with_intercept ? 1 : 0)) /
                          static_cast<double>(df_resid);
-  res.f =
-      perfect ? kInf : (ess_s / static_cast<double>(k)) / (rss_s / static_cast<double>(df_resid));
+  res.f = perfect ? kInf
+                  : (fit.ess_s / static_cast<double>(k)) / (rss_s / static_cast<double>(df_resid));
   res.f_p = f_upper_p(res.f, static_cast<double>(k), static_cast<double>(df_resid));
 
   res.residuals.resize(static_cast<std::size_t>(n));
   res.fitted.resize(static_cast<std::size_t>(n));
   for (Index i = 0; i < n; ++i) {
     const auto ui = static_cast<std::size_t>(i);
-    res.residuals[ui] = sy * e_s(i);
+    res.residuals[ui] = sy * fit.e_s(i);
     res.fitted[ui] = y[ui] - res.residuals[ui];
   }
 
-  add_residual_checks(e_s, columns, names, vif, worst, condition, perfect, options, &res);
+  add_residual_checks(fit.e_s, columns, names, v.vif, v.worst, f.condition, perfect, options, &res);
   require_finite(res);
   return res;
 }

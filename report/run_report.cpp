@@ -60,19 +60,15 @@ std::vector<std::string> split_pipes(const std::string& text) {
   return out;
 }
 
-}  // namespace
+// sections.csv split per algorithm: one "p_m_per_m v h f d" row per section, in the order the
+// algorithms first appear.
+struct SectionRows {
+  std::map<std::string, std::string> rows;  // by algorithm
+  std::vector<std::string> order;
+};
 
-PlotSet make_plots(const std::filesystem::path& dir, const Trajectory& gt,
-                   const std::vector<NamedTrajectory>& estimates, const std::string& sections_csv) {
-  const std::filesystem::path plots = dir / "plots";
-  std::filesystem::create_directories(plots / "data");
-  write_file_atomic(plots / "data" / "groundtruth.dat", trajectory_dat(gt, nullptr));
-  for (const auto& e : estimates)
-    write_file_atomic(plots / "data" / (e.name + ".dat"), trajectory_dat(e.trajectory, &gt));
-
-  // sections.csv split per algorithm: p_m_per_m and the covariates.
-  std::map<std::string, std::string> section_rows;
-  std::vector<std::string> section_order;
+SectionRows split_sections(const std::string& sections_csv) {
+  SectionRows out;
   std::istringstream in(sections_csv);
   std::string line;
   std::getline(in, line);
@@ -88,7 +84,7 @@ PlotSet make_plots(const std::filesystem::path& dir, const Trajectory& gt,
     const auto cells = split_csv_line(line);
     if (c_alg < 0 || c_p < 0 || cells.size() != header.size()) continue;
     const std::string& alg = cells[static_cast<std::size_t>(c_alg)];
-    if (!section_rows.count(alg)) section_order.push_back(alg);
+    if (!out.rows.count(alg)) out.order.push_back(alg);
     std::string row = cells[static_cast<std::size_t>(c_p)];
     for (const auto& c : cov_names) {
       const int i = column(c);
@@ -96,11 +92,151 @@ PlotSet make_plots(const std::filesystem::path& dir, const Trajectory& gt,
                         ? cells[static_cast<std::size_t>(i)]
                         : std::string("NaN"));
     }
-    section_rows[alg] += row + "\n";
+    out.rows[alg] += row + "\n";
   }
-  for (const auto& alg : section_order)
+  return out;
+}
+
+// Part of plots.gp and the plots it makes.
+struct PlotScript {
+  std::string gp;
+  std::vector<PlotFile> made;
+};
+
+// The plot command's curves: the truth (when `with_gt`) and every estimate.
+std::string curves(const std::vector<NamedTrajectory>& estimates, const std::string& using_gt,
+                   const std::string& using_est, bool with_gt) {
+  std::string s;
+  if (with_gt)
+    s += "'data/groundtruth.dat' using " + using_gt +
+         " with lines lw 2 lc 'black' title 'ground truth'";
+  for (const auto& e : estimates) {
+    if (!s.empty()) s += ", ";
+    s += q("data/" + e.name + ".dat") + " using " + using_est + " with lines title " + q(e.name);
+  }
+  return s;
+}
+
+// Top view (Fig. 6), position error over time and Euler angles (Fig. 7).
+PlotScript trajectory_plots(const std::vector<NamedTrajectory>& estimates) {
+  PlotScript out;
+  std::string& gp = out.gp;
+  gp +=
+      "set output 'top_view.png'\nset title 'Top view (river paper Fig. 6)'\n"
+      "set xlabel 'east [m]'\nset ylabel 'north [m]'\nset size ratio -1\n"
+      "plot " +
+      curves(estimates, "3:2", "3:2", true) + "\nset size noratio\n";
+  out.made.push_back(
+      {"Top view of the ground truth and every estimate (Fig. 6)", "plots/top_view.png"});
+  gp +=
+      "set output 'position_error.png'\nset title '3D position error'\n"
+      "set xlabel 'time [s]'\nset ylabel 'error [m]'\nplot " +
+      curves(estimates, "1:8", "1:8", false) + "\n";
+  out.made.push_back({"3D position error over time", "plots/position_error.png"});
+  gp +=
+      "set output 'euler.png'\nset multiplot layout 3,1 title 'Camera attitude, FRD axes (Fig. "
+      "7)'\n"
+      "set xlabel ''\n";
+  const char* angles[] = {"yaw", "pitch", "roll"};
+  for (int a = 0; a < 3; ++a) {
+    const std::string col = std::to_string(5 + a);
+    gp += fmt::format("set title ''\nset ylabel '{} [deg]'\n{}plot {}\n", angles[a],
+                      a == 2 ? "set xlabel 'time [s]'\n" : "",
+                      curves(estimates, "1:" + col, "1:" + col, true));
+  }
+  gp += "unset multiplot\n";
+  out.made.push_back({"Euler angles of the estimates and the truth (Fig. 7)", "plots/euler.png"});
+  return out;
+}
+
+// A covariate panel's least-squares line, a + b x, as a curve to append to its plot command;
+// empty when the points (x, e'_p) do not determine one.
+std::string least_squares_curve(const std::vector<std::array<double, 2>>& pts) {
+  double mx = 0, my = 0;
+  for (const auto& p : pts) {
+    mx += p[0] / static_cast<double>(pts.size());
+    my += p[1] / static_cast<double>(pts.size());
+  }
+  double sxx = 0, sxy = 0;
+  for (const auto& p : pts) {
+    sxx += (p[0] - mx) * (p[0] - mx);
+    sxy += (p[0] - mx) * (p[1] - my);
+  }
+  if (pts.size() >= 3 && sxx > 1e-12 * (1 + mx * mx) * static_cast<double>(pts.size())) {
+    const double b = sxy / sxx, a = my - b * mx;
+    return fmt::format(", {} + {} * x with lines lw 2 title 'least squares'", num(a), num(b));
+  }
+  return "";
+}
+
+// Section error against the covariates of one algorithm (Table 3): four panels, each with the
+// least-squares line of e'_p on its covariate. `rows` are the algorithm's section rows.
+std::string covariate_panels(const std::string& alg, const std::string& rows) {
+  std::string gp = "set output 'covariates.png'\nset multiplot layout 2,2 title " +
+                   q("Section error against the covariates, " + alg + " (Table 3)") + "\n";
+  const char* labels[] = {"v: speed [m/s]", "h: yaw rate sd [deg/s]", "f: inlier features",
+                          "d: mean feature depth [m]"};
+  // The least-squares line of each panel (simple regression of e'_p on one covariate).
+  std::vector<std::array<double, 2>> xy[4];
+  {
+    std::istringstream in(rows);
+    std::string r;
+    while (std::getline(in, r)) {
+      std::istringstream v(r);
+      double p = NAN, c[4] = {NAN, NAN, NAN, NAN};
+      v >> p >> c[0] >> c[1] >> c[2] >> c[3];
+      for (int k = 0; k < 4; ++k)
+        if (std::isfinite(p) && std::isfinite(c[k])) xy[k].push_back({c[k], p});
+    }
+  }
+  for (int c = 0; c < 4; ++c) {
+    const std::string data = q("data/sections_" + alg + ".dat");
+    gp += fmt::format("set title ''\nset xlabel '{}'\nset ylabel 'e''_p [m/m]'\n", labels[c]);
+    gp += fmt::format("plot {} using {}:1 with points pt 7 ps 0.6 title 'sections'", data, c + 2);
+    gp += least_squares_curve(xy[c]);
+    gp += "\n";
+  }
+  gp += "unset multiplot\n";
+  return gp;
+}
+
+// The section error histogram (Fig. 5) and the covariate panels of the first algorithm; none
+// without sections.
+PlotScript section_plots(const SectionRows& sections) {
+  PlotScript out;
+  if (sections.order.empty()) return out;
+  std::string& gp = out.gp;
+  gp +=
+      "set output 'section_errors.png'\nset title 'Section position error e''_p (Fig. 5)'\n"
+      "set xlabel 'e''_p [m/m]'\nset ylabel 'sections'\nset style fill transparent solid 0.4\n"
+      "bin(x) = 0.02 * floor(x / 0.02) + 0.01\nplot ";
+  for (std::size_t i = 0; i < sections.order.size(); ++i)
+    gp += (i ? ", " : "") + q("data/sections_" + sections.order[i] + ".dat") +
+          " using (bin($1)):(1) smooth frequency with boxes title " + q(sections.order[i]);
+  gp += "\nset style fill empty\n";
+  out.made.push_back({"Distribution of the section errors (Fig. 5)", "plots/section_errors.png"});
+  const std::string first = sections.order.front();
+  gp += covariate_panels(first, sections.rows.at(first));
+  out.made.push_back(
+      {"Section error against each covariate, with a least-squares line", "plots/covariates.png"});
+  return out;
+}
+
+}  // namespace
+
+PlotSet make_plots(const std::filesystem::path& dir, const Trajectory& gt,
+                   const std::vector<NamedTrajectory>& estimates, const std::string& sections_csv) {
+  const std::filesystem::path plots = dir / "plots";
+  std::filesystem::create_directories(plots / "data");
+  write_file_atomic(plots / "data" / "groundtruth.dat", trajectory_dat(gt, nullptr));
+  for (const auto& e : estimates)
+    write_file_atomic(plots / "data" / (e.name + ".dat"), trajectory_dat(e.trajectory, &gt));
+
+  // sections.csv split per algorithm: p_m_per_m and the covariates.
+  const SectionRows sections = split_sections(sections_csv);
+  for (const auto& alg : sections.order)
     write_file_atomic(plots / "data" / ("sections_" + alg + ".dat"),
-                      "# p_m_per_m v h f d\n" + section_rows[alg]);
+                      "# p_m_per_m v h f d\n" + sections.rows.at(alg));
 
   // Data files first: they are written whatever happens to gnuplot.
   const GnuplotLookup lookup = find_gnuplot();
@@ -112,94 +248,9 @@ PlotSet make_plots(const std::filesystem::path& dir, const Trajectory& gt,
       terminal +
       " size 900,640 font ',10' noenhanced\n"
       "set grid\nset key outside right top\n";
-  auto curves = [&](const std::string& using_gt, const std::string& using_est, bool with_gt) {
-    std::string s;
-    if (with_gt)
-      s += "'data/groundtruth.dat' using " + using_gt +
-           " with lines lw 2 lc 'black' title 'ground truth'";
-    for (const auto& e : estimates) {
-      if (!s.empty()) s += ", ";
-      s += q("data/" + e.name + ".dat") + " using " + using_est + " with lines title " + q(e.name);
-    }
-    return s;
-  };
-  gp +=
-      "set output 'top_view.png'\nset title 'Top view (river paper Fig. 6)'\n"
-      "set xlabel 'east [m]'\nset ylabel 'north [m]'\nset size ratio -1\n"
-      "plot " +
-      curves("3:2", "3:2", true) + "\nset size noratio\n";
-  made.push_back(
-      {"Top view of the ground truth and every estimate (Fig. 6)", "plots/top_view.png"});
-  gp +=
-      "set output 'position_error.png'\nset title '3D position error'\n"
-      "set xlabel 'time [s]'\nset ylabel 'error [m]'\nplot " +
-      curves("1:8", "1:8", false) + "\n";
-  made.push_back({"3D position error over time", "plots/position_error.png"});
-  gp +=
-      "set output 'euler.png'\nset multiplot layout 3,1 title 'Camera attitude, FRD axes (Fig. "
-      "7)'\n"
-      "set xlabel ''\n";
-  const char* angles[] = {"yaw", "pitch", "roll"};
-  for (int a = 0; a < 3; ++a) {
-    const std::string col = std::to_string(5 + a);
-    gp +=
-        fmt::format("set title ''\nset ylabel '{} [deg]'\n{}plot {}\n", angles[a],
-                    a == 2 ? "set xlabel 'time [s]'\n" : "", curves("1:" + col, "1:" + col, true));
-  }
-  gp += "unset multiplot\n";
-  made.push_back({"Euler angles of the estimates and the truth (Fig. 7)", "plots/euler.png"});
-  if (!section_order.empty()) {
-    gp +=
-        "set output 'section_errors.png'\nset title 'Section position error e''_p (Fig. 5)'\n"
-        "set xlabel 'e''_p [m/m]'\nset ylabel 'sections'\nset style fill transparent solid 0.4\n"
-        "bin(x) = 0.02 * floor(x / 0.02) + 0.01\nplot ";
-    for (std::size_t i = 0; i < section_order.size(); ++i)
-      gp += (i ? ", " : "") + q("data/sections_" + section_order[i] + ".dat") +
-            " using (bin($1)):(1) smooth frequency with boxes title " + q(section_order[i]);
-    gp += "\nset style fill empty\n";
-    made.push_back({"Distribution of the section errors (Fig. 5)", "plots/section_errors.png"});
-    const std::string first = section_order.front();
-    gp += "set output 'covariates.png'\nset multiplot layout 2,2 title " +
-          q("Section error against the covariates, " + first + " (Table 3)") + "\n";
-    const char* labels[] = {"v: speed [m/s]", "h: yaw rate sd [deg/s]", "f: inlier features",
-                            "d: mean feature depth [m]"};
-    // The least-squares line of each panel (simple regression of e'_p on one covariate).
-    std::vector<std::array<double, 2>> xy[4];
-    {
-      std::istringstream rows(section_rows[first]);
-      std::string r;
-      while (std::getline(rows, r)) {
-        std::istringstream v(r);
-        double p = NAN, c[4] = {NAN, NAN, NAN, NAN};
-        v >> p >> c[0] >> c[1] >> c[2] >> c[3];
-        for (int k = 0; k < 4; ++k)
-          if (std::isfinite(p) && std::isfinite(c[k])) xy[k].push_back({c[k], p});
-      }
-    }
-    for (int c = 0; c < 4; ++c) {
-      const std::string data = q("data/sections_" + first + ".dat");
-      gp += fmt::format("set title ''\nset xlabel '{}'\nset ylabel 'e''_p [m/m]'\n", labels[c]);
-      gp += fmt::format("plot {} using {}:1 with points pt 7 ps 0.6 title 'sections'", data, c + 2);
-      const auto& pts = xy[c];
-      double mx = 0, my = 0;
-      for (const auto& p : pts) {
-        mx += p[0] / static_cast<double>(pts.size());
-        my += p[1] / static_cast<double>(pts.size());
-      }
-      double sxx = 0, sxy = 0;
-      for (const auto& p : pts) {
-        sxx += (p[0] - mx) * (p[0] - mx);
-        sxy += (p[0] - mx) * (p[1] - my);
-      }
-      if (pts.size() >= 3 && sxx > 1e-12 * (1 + mx * mx) * static_cast<double>(pts.size())) {
-        const double b = sxy / sxx, a = my - b * mx;
-        gp += fmt::format(", {} + {} * x with lines lw 2 title 'least squares'", num(a), num(b));
-      }
-      gp += "\n";
-    }
-    gp += "unset multiplot\n";
-    made.push_back({"Section error against each covariate, with a least-squares line",
-                    "plots/covariates.png"});
+  for (const PlotScript& part : {trajectory_plots(estimates), section_plots(sections)}) {
+    gp += part.gp;
+    made.insert(made.end(), part.made.begin(), part.made.end());
   }
   write_file_atomic(plots / "plots.gp", gp);
   if (!lookup.gnuplot) return {{}, lookup.warning + ": no plots"};

@@ -459,24 +459,19 @@ bool inside(const BuildingSpec& b, double x, double y, double margin) {
   return x > b.x0_m - margin && x < b.x1_m + margin && y > b.y0_m - margin && y < b.y1_m + margin;
 }
 
-}  // namespace
-
-double river_terrain_z(const RiverReachOptions& options, std::uint64_t seed, double x_m,
-                       double y_m) {
-  const Bank k = bank_of(options);
-  const int side = y_m >= 0 ? 1 : -1;
-  return terrain_z(k, terrain_noise(seed), x_m, std::abs(y_m) - k.b, side);
+bool inside_any(const std::vector<BuildingSpec>& buildings, double x, double y, double margin) {
+  bool in_building = false;
+  for (const auto& B : buildings) in_building = in_building || inside(B, x, y, margin);
+  return in_building;
 }
 
-RiverTileLayout plan_river_tile(const RiverReachOptions& o, std::uint64_t seed, int index) {
-  const Bank k = bank_of(o);
-  const Noise n = terrain_noise(seed);
+// The tile's extent and where its bridge (with its piers) and quay go, without the bollards.
+RiverTileLayout plan_structures(const RiverReachOptions& o, const Bank& k, int index) {
   const double len = o.reach_length_m;
   RiverTileLayout L;
   L.index = index;
   L.x0_m = index * len;
   L.x1_m = L.x0_m + len;
-  Rng rng = RngStreams(seed).stream("scene.river.tile." + std::to_string(index));
 
   L.bridge = o.bridge;
   L.bridge_x_m = L.x0_m + 0.6 * len;
@@ -493,26 +488,39 @@ RiverTileLayout plan_river_tile(const RiverReachOptions& o, std::uint64_t seed, 
   L.quay = o.quay_wall;
   L.quay_x0_m = L.x0_m + 0.15 * len;
   L.quay_x1_m = L.quay_x0_m + std::min(kQuayLength_m, 0.3 * len);
+  return L;
+}
+
+// Bollards along the quay wall's cap, or one on the east bank when there is no quay.
+std::vector<Eigen::Vector3d> plan_bollards(const RiverTileLayout& L, const Bank& k,
+                                           const Noise& n) {
+  std::vector<Eigen::Vector3d> bollards_W;
   if (L.quay) {
     const double z_cap_top = -(k.H + 0.4) - 0.5;
     for (double x = L.quay_x0_m + 5.0; x < L.quay_x1_m - 1.0; x += 10.0)
-      L.bollards_W.emplace_back(x, k.b + 0.3, z_cap_top);
+      bollards_W.emplace_back(x, k.b + 0.3, z_cap_top);
   } else {
     const double x = L.quay_x0_m + 5.0, s = k.run + 1.0;
-    L.bollards_W.emplace_back(x, k.b + s, terrain_z(k, n, x, s, 1));
+    bollards_W.emplace_back(x, k.b + s, terrain_z(k, n, x, s, 1));
   }
+  return bollards_W;
+}
 
-  // Buildings: evenly spread along the tile, alternating banks, behind the
-  // trees; none on the bridge's road.
+// Buildings: evenly spread along the tile, alternating banks, behind the
+// trees; none on the bridge's road.
+std::vector<BuildingSpec> plan_buildings(const RiverReachOptions& o, const Bank& k, const Noise& n,
+                                         const RiverTileLayout& L, Rng* rng) {
+  const double len = o.reach_length_m;
+  std::vector<BuildingSpec> buildings;
   const int nb = o.buildings;
   for (int i = 0; i < nb; ++i) {
     const int side = i % 2 == 0 ? 1 : -1;
     const double slot = len / nb;
-    double xc = L.x0_m + (i + 0.5) * slot + rng.uniform(-0.15, 0.15) * slot;
-    const double w = std::min(rng.uniform(8.0, 14.0), 0.8 * slot);
-    const double d = rng.uniform(8.0, 12.0);
-    const int floors = 1 + static_cast<int>(rng.uniform_int(3));
-    const double s_front = std::min(o.tree_line_distance_m + 10.0 + rng.uniform(0.0, 12.0),
+    double xc = L.x0_m + (i + 0.5) * slot + rng->uniform(-0.15, 0.15) * slot;
+    const double w = std::min(rng->uniform(8.0, 14.0), 0.8 * slot);
+    const double d = rng->uniform(8.0, 12.0);
+    const int floors = 1 + static_cast<int>(rng->uniform_int(3));
+    const double s_front = std::min(o.tree_line_distance_m + 10.0 + rng->uniform(0.0, 12.0),
                                     kFarFieldStart_m - 2.0 - d);
     if (L.bridge && std::abs(xc - L.bridge_x_m) < w / 2 + L.bridge_half_width_m + 3.0)
       xc = L.bridge_x_m + (xc >= L.bridge_x_m ? 1 : -1) * (w / 2 + L.bridge_half_width_m + 3.0);
@@ -532,63 +540,92 @@ RiverTileLayout plan_river_tile(const RiverReachOptions& o, std::uint64_t seed, 
     B.ground_z_m = zlow + 0.3;  // walls start below the ground everywhere
     B.eave_z_m = zhigh - 3.0 * floors;
     B.ridge_z_m = B.eave_z_m - 0.5 * std::min(w, d) * std::tan(35.0 * kPi / 180.0);
-    L.buildings.push_back(B);
+    buildings.push_back(B);
   }
+  return buildings;
+}
 
-  // Trees: two rows per bank, the first at the tree line. Every candidate
-  // draws the same numbers whether or not it is kept, so removing one (for the
-  // bridge, the quay, a building) does not move the others.
-  if (o.vegetation_density > 0) {
-    const double spacing = kTreeSpacingAtFull_m / o.vegetation_density;
-    const int per_row = std::max(1, static_cast<int>(std::floor(len / spacing)));
-    for (int side : {1, -1})
-      for (int row = 0; row < 2; ++row)
-        for (int i = 0; i < per_row; ++i) {
-          const double x = L.x0_m + len * (i + 0.5) / per_row + rng.uniform(-0.3, 0.3) * spacing;
-          // Separate statements: the order of two draws in one expression is unspecified.
-          double ds = rng.uniform(-0.5, 0.5);
-          if (row > 0) ds += rng.uniform(-1.5, 1.5);
-          TreeSpec t;
-          t.height_m = o.tree_height_m * rng.uniform(kTreeHeightMin, kTreeHeightMax);
-          t.crown_radius_m = t.height_m * rng.uniform(0.22, 0.32);
-          t.trunk_radius_m = 0.1 + 0.02 * t.height_m;
-          // The whole trunk stands behind the water's edge.
-          const double s =
-              std::max(o.tree_line_distance_m + row * kTreeRowGap_m + ds, t.trunk_radius_m + 0.3);
-          const double y = side * (k.b + s);
-          if (L.bridge && std::abs(x - L.bridge_x_m) < L.bridge_half_width_m + 3.0 &&
-              s < kBridgeLandSpan_m + 25.0)
-            continue;
-          if (L.quay && side > 0 && x > L.quay_x0_m - 3.0 && x < L.quay_x1_m + 3.0 &&
-              s < kQuayPaving_m + 1.0)
-            continue;
-          bool in_building = false;
-          for (const auto& B : L.buildings) in_building = in_building || inside(B, x, y, 1.0);
-          if (in_building) continue;
-          t.base_W = Vec3(x, y, terrain_z(k, n, x, s, side));
-          L.trees.push_back(t);
-        }
-  }
-
-  // Bushes (willow scrub) on the bank between the reeds and the tree line,
-  // drawn after the trees so that they do not move them.
-  const int bushes = static_cast<int>(std::round(o.vegetation_density * len / 6.0));
+// Trees: two rows per bank, the first at the tree line. Every candidate
+// draws the same numbers whether or not it is kept, so removing one (for the
+// bridge, the quay, a building) does not move the others.
+std::vector<TreeSpec> plan_trees(const RiverReachOptions& o, const Bank& k, const Noise& n,
+                                 const RiverTileLayout& L, Rng* rng) {
+  std::vector<TreeSpec> trees;
+  if (!(o.vegetation_density > 0)) return trees;
+  const double len = o.reach_length_m;
+  const double spacing = kTreeSpacingAtFull_m / o.vegetation_density;
+  const int per_row = std::max(1, static_cast<int>(std::floor(len / spacing)));
   for (int side : {1, -1})
-    for (int i = 0; i < bushes; ++i) {
-      const double x = rng.uniform(L.x0_m, L.x1_m);
-      const double s = rng.uniform(0.5, std::max(1.0, o.tree_line_distance_m));
+    for (int row = 0; row < 2; ++row)
+      for (int i = 0; i < per_row; ++i) {
+        const double x = L.x0_m + len * (i + 0.5) / per_row + rng->uniform(-0.3, 0.3) * spacing;
+        // Separate statements: the order of two draws in one expression is unspecified.
+        double ds = rng->uniform(-0.5, 0.5);
+        if (row > 0) ds += rng->uniform(-1.5, 1.5);
+        TreeSpec t;
+        t.height_m = o.tree_height_m * rng->uniform(kTreeHeightMin, kTreeHeightMax);
+        t.crown_radius_m = t.height_m * rng->uniform(0.22, 0.32);
+        t.trunk_radius_m = 0.1 + 0.02 * t.height_m;
+        // The whole trunk stands behind the water's edge.
+        const double s =
+            std::max(o.tree_line_distance_m + row * kTreeRowGap_m + ds, t.trunk_radius_m + 0.3);
+        const double y = side * (k.b + s);
+        if (L.bridge && std::abs(x - L.bridge_x_m) < L.bridge_half_width_m + 3.0 &&
+            s < kBridgeLandSpan_m + 25.0)
+          continue;
+        if (L.quay && side > 0 && x > L.quay_x0_m - 3.0 && x < L.quay_x1_m + 3.0 &&
+            s < kQuayPaving_m + 1.0)
+          continue;
+        if (inside_any(L.buildings, x, y, 1.0)) continue;
+        t.base_W = Vec3(x, y, terrain_z(k, n, x, s, side));
+        trees.push_back(t);
+      }
+  return trees;
+}
+
+// Bushes (willow scrub) on the bank between the reeds and the tree line,
+// drawn after the trees so that they do not move them.
+std::vector<TreeSpec> plan_bushes(const RiverReachOptions& o, const Bank& k, const Noise& n,
+                                  const RiverTileLayout& L, Rng* rng) {
+  const double len = o.reach_length_m;
+  std::vector<TreeSpec> bushes;
+  const int count = static_cast<int>(std::round(o.vegetation_density * len / 6.0));
+  for (int side : {1, -1})
+    for (int i = 0; i < count; ++i) {
+      const double x = rng->uniform(L.x0_m, L.x1_m);
+      const double s = rng->uniform(0.5, std::max(1.0, o.tree_line_distance_m));
       TreeSpec t;
-      t.height_m = rng.uniform(1.5, 3.5);
-      t.crown_radius_m = t.height_m * rng.uniform(0.5, 0.8);
+      t.height_m = rng->uniform(1.5, 3.5);
+      t.crown_radius_m = t.height_m * rng->uniform(0.5, 0.8);
       const double y = side * (k.b + s);
       if (L.bridge && std::abs(x - L.bridge_x_m) < L.bridge_half_width_m + 3.0) continue;
       if (L.quay && side > 0 && x > L.quay_x0_m - 3.0 && x < L.quay_x1_m + 3.0) continue;
-      bool in_building = false;
-      for (const auto& B : L.buildings) in_building = in_building || inside(B, x, y, 1.0);
-      if (in_building) continue;
+      if (inside_any(L.buildings, x, y, 1.0)) continue;
       t.base_W = Vec3(x, y, terrain_z(k, n, x, s, side));
-      L.bushes.push_back(t);
+      bushes.push_back(t);
     }
+  return bushes;
+}
+
+}  // namespace
+
+double river_terrain_z(const RiverReachOptions& options, std::uint64_t seed, double x_m,
+                       double y_m) {
+  const Bank k = bank_of(options);
+  const int side = y_m >= 0 ? 1 : -1;
+  return terrain_z(k, terrain_noise(seed), x_m, std::abs(y_m) - k.b, side);
+}
+
+RiverTileLayout plan_river_tile(const RiverReachOptions& o, std::uint64_t seed, int index) {
+  const Bank k = bank_of(o);
+  const Noise n = terrain_noise(seed);
+  Rng rng = RngStreams(seed).stream("scene.river.tile." + std::to_string(index));
+  RiverTileLayout L = plan_structures(o, k, index);
+  L.bollards_W = plan_bollards(L, k, n);
+  // One stream in this order: buildings, trees, bushes.
+  L.buildings = plan_buildings(o, k, n, L, &rng);
+  L.trees = plan_trees(o, k, n, L, &rng);
+  L.bushes = plan_bushes(o, k, n, L, &rng);
   return L;
 }
 

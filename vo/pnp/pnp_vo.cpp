@@ -147,6 +147,92 @@ struct PnpStereoOdometry::Impl {
     select_inliers(*rvec, *tvec, &inliers);
     return static_cast<int>(inliers.size()) >= options.min_inliers;
   }
+
+  // Steps 1-2: crop, GFTT, descriptors (basin paper: "done on the left and right frames in
+  // parallel"; sequential here, so the thread count never changes a result).
+  void extract_features(const StereoFrame& frame) {
+    extractor.extract(frame.left, &left);
+    extractor.extract(frame.right, &right);
+    if (options.subpixel_alignment) {
+      const cv::Rect crop(0, 0, frame.left.cols, extractor.crop_rows());
+      frame.left(crop).convertTo(left_f1, CV_32F);
+      frame.right(crop).convertTo(right_f, CV_32F);
+    }
+  }
+
+  // Step 4a: current left features against the previous pair's points, within a window. Returns
+  // the number of correspondences (corr).
+  int match_temporal() {
+    pnp::MatchWindow w;
+    w.row_band_px = options.max_image_motion_px;
+    w.du_min_px = -options.max_image_motion_px;
+    w.du_max_px = options.max_image_motion_px;
+    pnp::match_features(points0.px, points0.descriptors, left.px, left.descriptors, w,
+                        max_hamming(left.bits()), options.cross_check, &temporal);
+    corr.clear();
+    for (const IndexMatch& m : temporal) {
+      cv::Point2f p = left.px[static_cast<std::size_t>(m.b)];
+      // Where the previous corner's window is now: the pixel of the very point whose 3D position
+      // Eq. (1) gave, rather than an independently detected (and quantised) corner near it.
+      if (options.subpixel_alignment &&
+          !aligner.align(left_f0, points0.px[static_cast<std::size_t>(m.a)], left_f1,
+                         /*horizontal_only=*/false, &p))
+        continue;
+      corr.object.push_back(xyz0[static_cast<std::size_t>(m.a)]);
+      corr.image.emplace_back(p.x, p.y);
+    }
+    return static_cast<int>(corr.object.size());
+  }
+
+  // A pose (rvec, tvec: previous -> current) and its inlier count; the count is what failed
+  // the check when !ok.
+  struct PoseEstimate {
+    bool ok = false;
+    cv::Vec3d rvec, tvec;
+    int inliers = 0;
+  };
+
+  // Step 4b: PnP inside RANSAC, then (refine_on_inliers) Levenberg-Marquardt on the inliers;
+  // `inliers` holds the final inliers.
+  PoseEstimate estimate_pose() {
+    // OpenCV draws samples from its thread-local RNG; seeding it from our stream makes the draw
+    // a function of (scenario seed, frame index) only.
+    cv::theRNG().state = rng.next_u64() | 1u;  // a zero state would make OpenCV's RNG constant
+    cv::Vec3d rvec(0.0, 0.0, 0.0), tvec(0.0, 0.0, 0.0);
+    std::vector<int> ransac_inliers;
+    inliers.clear();
+    bool ok = false;
+    try {
+      ok = cv::solvePnPRansac(corr.object, corr.image, K, cv::noArray(), rvec, tvec,
+                              /*useExtrinsicGuess=*/false, options.ransac_iterations,
+                              static_cast<float>(options.ransac_reprojection_px),
+                              options.ransac_confidence, ransac_inliers, cv::SOLVEPNP_ITERATIVE);
+    } catch (const cv::Exception&) {
+      // Degenerate samples (e.g. all points on a line) make some OpenCV solvers throw; to the VO
+      // that is one more failed frame.
+      ok = false;
+    }
+    if (ok && options.refine_on_inliers) {
+      ok = refine(&rvec, &tvec);
+    } else if (ok) {
+      inliers = ransac_inliers;
+      ok = static_cast<int>(inliers.size()) >= options.min_inliers;
+    }
+    if (!ok)
+      return {false, rvec, tvec,
+              static_cast<int>(options.refine_on_inliers ? inliers.size() : ransac_inliers.size())};
+    return {true, rvec, tvec, static_cast<int>(inliers.size())};
+  }
+
+  // Mean depth of the inliers in the current camera.
+  double mean_inlier_depth(const SE3& T_curr_prev) const {
+    double depth_sum = 0.0;
+    for (const int i : inliers) {
+      const cv::Point3d& o = corr.object[static_cast<std::size_t>(i)];
+      depth_sum += (T_curr_prev * Vec3(o.x, o.y, o.z)).z();
+    }
+    return depth_sum / static_cast<int>(inliers.size());
+  }
 };
 
 PnpStereoOdometry::PnpStereoOdometry(const StereoRig& rig, const PnpVoOptions& options, Rng rng) {
@@ -188,15 +274,7 @@ VoResult PnpStereoOdometry::process(const StereoFrame& frame) {
   VoResult result;
   s.stats = {};
 
-  // Steps 1-2: crop, GFTT, descriptors (basin paper: "done on the left and right frames in
-  // parallel"; sequential here, so the thread count never changes a result).
-  s.extractor.extract(frame.left, &s.left);
-  s.extractor.extract(frame.right, &s.right);
-  if (s.options.subpixel_alignment) {
-    const cv::Rect crop(0, 0, frame.left.cols, s.extractor.crop_rows());
-    frame.left(crop).convertTo(s.left_f1, CV_32F);
-    frame.right(crop).convertTo(s.right_f, CV_32F);
-  }
+  s.extract_features(frame);
   result.times.detect_ms = ms_since(t_start);
   s.stats.left_features = static_cast<int>(s.left.size());
   s.stats.right_features = static_cast<int>(s.right.size());
@@ -233,78 +311,33 @@ VoResult PnpStereoOdometry::process(const StereoFrame& frame) {
   if (static_cast<int>(s.points0.size()) < s.options.min_inliers)
     return finish("too few stereo points in the previous frame");
 
-  // Step 4a: current left features against the previous pair's points, within a window.
   t = SteadyClock::now();
-  pnp::MatchWindow w;
-  w.row_band_px = s.options.max_image_motion_px;
-  w.du_min_px = -s.options.max_image_motion_px;
-  w.du_max_px = s.options.max_image_motion_px;
-  pnp::match_features(s.points0.px, s.points0.descriptors, s.left.px, s.left.descriptors, w,
-                      s.max_hamming(s.left.bits()), s.options.cross_check, &s.temporal);
-  s.corr.clear();
-  for (const IndexMatch& m : s.temporal) {
-    cv::Point2f p = s.left.px[static_cast<std::size_t>(m.b)];
-    // Where the previous corner's window is now: the pixel of the very point whose 3D position
-    // Eq. (1) gave, rather than an independently detected (and quantised) corner near it.
-    if (s.options.subpixel_alignment &&
-        !s.aligner.align(s.left_f0, s.points0.px[static_cast<std::size_t>(m.a)], s.left_f1,
-                         /*horizontal_only=*/false, &p))
-      continue;
-    s.corr.object.push_back(s.xyz0[static_cast<std::size_t>(m.a)]);
-    s.corr.image.emplace_back(p.x, p.y);
-  }
+  result.matches = s.match_temporal();
   match_ms += ms_since(t);
-  result.matches = static_cast<int>(s.corr.object.size());
   s.stats.temporal_matches = result.matches;
   if (result.matches < s.options.min_inliers) return finish("too few temporal matches");
 
-  // Step 4b: PnP inside RANSAC. OpenCV draws samples from its thread-local RNG; seeding it from
-  // our stream makes the draw a function of (scenario seed, frame index) only.
   t = SteadyClock::now();
-  cv::theRNG().state = s.rng.next_u64() | 1u;  // a zero state would make OpenCV's RNG constant
-  cv::Vec3d rvec(0.0, 0.0, 0.0), tvec(0.0, 0.0, 0.0);
-  std::vector<int> ransac_inliers;
-  s.inliers.clear();
-  bool ok = false;
-  try {
-    ok = cv::solvePnPRansac(s.corr.object, s.corr.image, s.K, cv::noArray(), rvec, tvec,
-                            /*useExtrinsicGuess=*/false, s.options.ransac_iterations,
-                            static_cast<float>(s.options.ransac_reprojection_px),
-                            s.options.ransac_confidence, ransac_inliers, cv::SOLVEPNP_ITERATIVE);
-  } catch (const cv::Exception&) {
-    // Degenerate samples (e.g. all points on a line) make some OpenCV solvers throw; to the VO
-    // that is one more failed frame.
-    ok = false;
-  }
-  if (ok && s.options.refine_on_inliers) {
-    ok = s.refine(&rvec, &tvec);
-  } else if (ok) {
-    s.inliers = ransac_inliers;
-    ok = static_cast<int>(s.inliers.size()) >= s.options.min_inliers;
-  }
+  const Impl::PoseEstimate pose = s.estimate_pose();
   result.times.estimate_ms = ms_since(t);
   result.times.match_ms = match_ms;
-  if (!ok) {
-    result.inliers =
-        static_cast<int>(s.options.refine_on_inliers ? s.inliers.size() : ransac_inliers.size());
+  if (!pose.ok) {
+    result.inliers = pose.inliers;
     s.stats.inliers = result.inliers;
     return finish("too few PnP inliers");
   }
 
   // solvePnP's pose maps previous-frame points into the current camera: T_curr_prev.
+  const cv::Vec3d& rvec = pose.rvec;
+  const cv::Vec3d& tvec = pose.tvec;
   const SE3 T_curr_prev(so3_exp(Vec3(rvec[0], rvec[1], rvec[2])), Vec3(tvec[0], tvec[1], tvec[2]));
   const SE3 T_prev_curr = T_curr_prev.inverse();
   if (!detail::is_finite(T_prev_curr)) return finish("motion estimate not finite");
-  double depth_sum = 0.0;
-  for (const int i : s.inliers) {
-    const cv::Point3d& o = s.corr.object[static_cast<std::size_t>(i)];
-    depth_sum += (T_curr_prev * Vec3(o.x, o.y, o.z)).z();
-  }
   result.valid = true;
   result.T_prev_curr = T_prev_curr;
-  result.inliers = static_cast<int>(s.inliers.size());
+  result.inliers = pose.inliers;
   s.stats.inliers = result.inliers;
-  result.mean_inlier_depth_m = depth_sum / result.inliers;
+  result.mean_inlier_depth_m = s.mean_inlier_depth(T_curr_prev);
   if (!std::isfinite(result.mean_inlier_depth_m)) return finish("mean depth not finite");
   result.times.total_ms = ms_since(t_start);
   return result;

@@ -152,6 +152,85 @@ struct SparseStereoOdometry::Impl {
       points.push_back(p);
     }
   }
+
+  // Features of the current pair (and its images, for lk_refinement).
+  void detect(const StereoFrame& frame) {
+    detector.detect(frame.left, &l1);
+    detector.detect(frame.right, &r1);
+    if (options.lk_refinement) {  // copies into buffers kept across frames: no allocation
+      frame.left.copyTo(img_l1);
+      frame.right.copyTo(img_r1);
+    }
+  }
+
+  // Why the current or the reference pair has too few features to match; nullptr if neither.
+  const char* feature_shortage() const {
+    const auto min_features = static_cast<std::size_t>(options.min_inliers);
+    if (l1.all.features.size() < min_features || r1.all.features.size() < min_features)
+      return "too few features in the current images (no texture?)";
+    if (l0.all.features.size() < min_features || r0.all.features.size() < min_features)
+      return "too few features in the previous images (no texture?)";
+    return nullptr;
+  }
+
+  // One matching stage's motion estimate and how long its steps took.
+  struct Stage {
+    sparse::StereoMotionEstimator::Result est;
+    double match_ms = 0.0, estimate_ms = 0.0;
+  };
+
+  // Circular matching (the coarse sets alone, or every feature, Lucas-Kanade refined when
+  // lk_refinement, around the prior's predictions when there is one) and RANSAC on Eq. (2).
+  Stage match_and_estimate(bool coarse_only, const SE3* prior) {
+    Stage out;
+    auto t = SteadyClock::now();
+    matcher.match(l1, r1, l0, r0, coarse_only, prior, &circles);
+    if (!coarse_only && options.lk_refinement && !circles.empty()) lk_refine();
+    out.match_ms = ms_since(t);
+    t = SteadyClock::now();
+    to_points();
+    // RANSAC hypotheses start from the prior when there is one: fewer Gauss-Newton iterations.
+    out.est = estimator.estimate(points, &rng, prior != nullptr ? prior->inverse() : SE3());
+    out.estimate_ms = ms_since(t);
+    return out;
+  }
+
+  // The matches as last_matches() reports them, none an inlier yet.
+  void record_matches() {
+    for (const CircleMatch& c : circles)
+      infos.push_back({c.u_lc, c.v_lc, c.u_rc, c.u_lp, c.v_lp, c.u_rp, false});
+  }
+
+  // Flags the inliers in last_matches() and returns their mean depth in the current pair.
+  double flag_inliers(const std::vector<int>& inliers) {
+    double depth_sum = 0.0;
+    for (const int i : inliers) {
+      const CircleMatch& c = circles[static_cast<std::size_t>(i)];
+      infos[static_cast<std::size_t>(i)].inlier = true;
+      depth_sum += rig.depth_from_disparity(c.u_lc - c.u_rc);  // Eq. (1), current pair
+    }
+    return depth_sum / static_cast<int>(inliers.size());
+  }
+
+  // On leaving process(): unless a keyframe stays the reference (keep_reference), the current
+  // pair becomes the reference pair.
+  struct Advance {
+    Impl& s;
+    bool keep_reference = false;
+    ~Advance() {
+      if (keep_reference) {
+        ++s.key_frames_back;
+        return;
+      }
+      std::swap(s.l0, s.l1);
+      std::swap(s.r0, s.r1);
+      cv::swap(s.img_l0, s.img_l1);
+      cv::swap(s.img_r0, s.img_r1);
+      s.has_previous = true;
+      s.T_key_prev = SE3();
+      s.key_frames_back = 1;
+    }
+  };
 };
 
 SparseStereoOdometry::SparseStereoOdometry(const StereoRig& rig, const SparseVoOptions& options,
@@ -198,33 +277,12 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   s.circles.clear();
   s.infos.clear();
 
-  s.detector.detect(frame.left, &s.l1);
-  s.detector.detect(frame.right, &s.r1);
-  if (s.options.lk_refinement) {  // copies into buffers kept across frames: no allocation
-    frame.left.copyTo(s.img_l1);
-    frame.right.copyTo(s.img_r1);
-  }
+  s.detect(frame);
   result.times.detect_ms = ms_since(t_start);
 
   // Unless a keyframe stays the reference (keep_reference), this pair is the next call's
   // reference pair, whatever happens below.
-  struct Advance {
-    Impl& s;
-    bool keep_reference = false;
-    ~Advance() {
-      if (keep_reference) {
-        ++s.key_frames_back;
-        return;
-      }
-      std::swap(s.l0, s.l1);
-      std::swap(s.r0, s.r1);
-      cv::swap(s.img_l0, s.img_l1);
-      cv::swap(s.img_r0, s.img_r1);
-      s.has_previous = true;
-      s.T_key_prev = SE3();
-      s.key_frames_back = 1;
-    }
-  } advance{s};
+  Impl::Advance advance{s};
   result.reference_frames_back = s.key_frames_back;
 
   auto finish = [&](std::string reason) {
@@ -238,11 +296,7 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   };
 
   if (!s.has_previous) return finish("first frame");
-  const auto min_features = static_cast<std::size_t>(s.options.min_inliers);
-  if (s.l1.all.features.size() < min_features || s.r1.all.features.size() < min_features)
-    return finish("too few features in the current images (no texture?)");
-  if (s.l0.all.features.size() < min_features || s.r0.all.features.size() < min_features)
-    return finish("too few features in the previous images (no texture?)");
+  if (const char* shortage = s.feature_shortage()) return finish(shortage);
 
   // Stage 1 (two_stage_matching): the coarse sets alone, wide windows, and a motion prior
   // from them; stage 2: every feature, narrow windows around the prior's predictions.
@@ -250,38 +304,25 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   SE3 prior_T_prev_curr;
   const SE3* prior = nullptr;
   if (s.options.two_stage_matching) {
-    auto t = SteadyClock::now();
-    s.matcher.match(s.l1, s.r1, s.l0, s.r0, /*coarse_only=*/true, nullptr, &s.circles);
-    match_ms += ms_since(t);
-    t = SteadyClock::now();
-    s.to_points();
-    const auto coarse = s.estimator.estimate(s.points, &s.rng);
-    estimate_ms += ms_since(t);
-    if (!coarse.ok) {
+    const Impl::Stage coarse = s.match_and_estimate(/*coarse_only=*/true, nullptr);
+    match_ms += coarse.match_ms;
+    estimate_ms += coarse.estimate_ms;
+    if (!coarse.est.ok) {
       result.matches = static_cast<int>(s.circles.size());
       result.times.match_ms = match_ms;
       result.times.estimate_ms = estimate_ms;
-      return finish("coarse matching failed: " + coarse.failure);
+      return finish("coarse matching failed: " + coarse.est.failure);
     }
-    prior_T_prev_curr = coarse.T_curr_prev.inverse();
+    prior_T_prev_curr = coarse.est.T_curr_prev.inverse();
     prior = &prior_T_prev_curr;
   }
-  auto t = SteadyClock::now();
-  s.matcher.match(s.l1, s.r1, s.l0, s.r0, /*coarse_only=*/false, prior, &s.circles);
-  if (s.options.lk_refinement && !s.circles.empty()) s.lk_refine();
-  match_ms += ms_since(t);
-  t = SteadyClock::now();
-  s.to_points();
-  // RANSAC hypotheses start from the prior when there is one: fewer Gauss-Newton iterations.
-  const auto est =
-      s.estimator.estimate(s.points, &s.rng, prior != nullptr ? prior->inverse() : SE3());
-  estimate_ms += ms_since(t);
-  result.times.match_ms = match_ms;
-  result.times.estimate_ms = estimate_ms;
+  const Impl::Stage fine = s.match_and_estimate(/*coarse_only=*/false, prior);
+  const auto& est = fine.est;
+  result.times.match_ms = match_ms + fine.match_ms;
+  result.times.estimate_ms = estimate_ms + fine.estimate_ms;
   result.matches = static_cast<int>(s.circles.size());
 
-  for (const CircleMatch& c : s.circles)
-    s.infos.push_back({c.u_lc, c.v_lc, c.u_rc, c.u_lp, c.v_lp, c.u_rp, false});
+  s.record_matches();
   if (!est.ok) return finish(est.failure);
   const SE3 T_ref_curr = est.T_curr_prev.inverse();
   if (!detail::is_finite(T_ref_curr)) return finish("motion estimate not finite");
@@ -289,21 +330,15 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   // Eq. (3) then telescopes to keyframe pose * T_ref_curr.
   SE3 T_prev_curr = s.T_key_prev.inverse() * T_ref_curr;
   if (s.window_ba) {  // falls back to the frame-to-frame estimate when the window solve fails
-    t = SteadyClock::now();
+    const auto t = SteadyClock::now();
     T_prev_curr = s.window_ba->add_frame(s.circles, *est.inliers, T_prev_curr).T_prev_curr;
     result.times.estimate_ms += ms_since(t);
   }
 
-  double depth_sum = 0.0;
-  for (const int i : *est.inliers) {
-    const CircleMatch& c = s.circles[static_cast<std::size_t>(i)];
-    s.infos[static_cast<std::size_t>(i)].inlier = true;
-    depth_sum += s.rig.depth_from_disparity(c.u_lc - c.u_rc);  // Eq. (1), current pair
-  }
   result.valid = true;
   result.T_prev_curr = T_prev_curr;
   result.inliers = static_cast<int>(est.inliers->size());
-  result.mean_inlier_depth_m = depth_sum / result.inliers;
+  result.mean_inlier_depth_m = s.flag_inliers(*est.inliers);
   if (!std::isfinite(result.mean_inlier_depth_m)) return finish("mean depth not finite");
   if (s.options.keyframes && s.keeps_keyframe(*est.inliers, T_ref_curr)) {
     advance.keep_reference = true;
