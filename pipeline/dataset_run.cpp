@@ -46,9 +46,8 @@ eval::FrameTable covariates(const VoTrack& t, const std::vector<dataset::Dataset
   for (std::size_t k = 0; k < t.results.size(); ++k) {
     const vo::VoResult& r = t.results[k];
     ft.t_ns.push_back(frames[k].t_ns);
-    // Covariate f: inlier features (sparse, river paper Table 4), pixels with depth (dense).
-    const double f = t.name == "dense" ? r.valid_depth_pixels : r.inliers;
-    ft.columns[0].push_back(r.valid ? f : nan);
+    // Covariate f as the VO counts its features (river paper Table 4).
+    ft.columns[0].push_back(r.valid ? r.feature_count() : nan);
     ft.columns[1].push_back(r.valid ? r.mean_inlier_depth_m : nan);
   }
   return ft;

@@ -1,8 +1,8 @@
-// The filters of a run that read more than one VO (pipeline.fusion: ned_kf, ned_pf, eskf):
-// each follows one VO track frame by frame, with the compass, IMU and GPS measurements of the
-// sensors stage fed in time order. Filters see measurements only, never ground truth; the
-// start position is the run's anchor (the true first pose, as for every VO track, so that
-// the estimates overlay), the start attitude comes from the sensors.
+// The filters of a run (pipeline.fusion: ca_smoother, ned_kf, ned_pf, eskf): each follows one
+// VO track frame by frame through fusion::Filter, with the compass, IMU and GPS measurements of
+// the sensors stage fed in time order. Filters see measurements only, never ground truth; the
+// start position is the run's anchor (the true first pose, as for every VO track, so that the
+// estimates overlay), the start attitude comes from the sensors.
 #pragma once
 
 #include <cstdint>
@@ -12,6 +12,7 @@
 
 #include "core/rng.hpp"
 #include "core/se3.hpp"
+#include "fusion/filter.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/sensor_stage.hpp"
 #include "vo/stereo_odometry.hpp"
@@ -28,13 +29,15 @@ struct FilterCounts {
 
 class FilterTrack {
  public:
-  /// `T_W_B0`: the anchor, the body pose at the first frame.
+  /// `T_W_B0`: the anchor, the body pose at the first frame; `T_W_C0`: the left camera's pose
+  /// there (where the smoother's chain starts).
   FilterTrack(FusionAlgorithm kind, const Scenario& sc, const SensorData& sensors,
-              const SE3& T_W_B0, const RngStreams& rng);
+              const SE3& T_W_B0, const SE3& T_W_C0, const RngStreams& rng);
   ~FilterTrack();
   FilterTrack(FilterTrack&&) noexcept;
 
-  /// Frame at t_ns (times increasing) with its VO result; returns the left camera's pose.
+  /// Frame at t_ns (times increasing) with its VO result, after every measurement up to t_ns;
+  /// returns the left camera's pose.
   SE3 step(TimeNs t_ns, const vo::VoResult& vo);
   /// NED filters: writes their per-step state (N, E, u, v, heading) as CSV at `path`.
   void write_states(const std::filesystem::path& path) const;
@@ -43,8 +46,13 @@ class FilterTrack {
   FilterCounts counts() const;
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  void feed_until(TimeNs t_ns);
+
+  FusionAlgorithm kind_;
+  const SensorData* sensors_;
+  std::unique_ptr<fusion::Filter> filter_;
+  double gps_sigma_h_ = 1.5;
+  std::size_t next_imu_ = 0, next_gps_ = 0, next_compass_ = 0;
 };
 
 }  // namespace driftlab::pipeline

@@ -146,12 +146,11 @@ sim::MotionSummary simulate_scenario_motion(
 
 namespace {
 
-// One estimate stream: a VO, optionally followed by the constant-acceleration smoother.
+// One estimate stream: a VO, or a filter following one (fusion::Filter), or an external VO.
 struct Track {
   std::string name;
   std::unique_ptr<vo::StereoOdometry> vo;
-  std::unique_ptr<fusion::ConstantAccelerationSmoother> smoother;  // set for NAME_ca streams
-  std::unique_ptr<FilterTrack> filter;  // NAME_ned_kf, NAME_ned_pf, NAME_eskf streams
+  std::unique_ptr<FilterTrack> filter;  // NAME_ca, NAME_ned_kf, NAME_ned_pf, NAME_eskf streams
   std::size_t source = 0;               // for a smoothed stream: the VO track it follows
   bool external = false;                // an external VO's estimate (pipeline.external_vo)
   Trajectory estimate;
@@ -161,7 +160,7 @@ struct Track {
 
 // Fig. 3 of the river paper: the current left image above the right one, each match's
 // points joined across the pair, its flow from the previous frame drawn in the left image.
-cv::Mat draw_matches(const vo::StereoFrame& frame, std::span<const vo::SparseMatchInfo> matches) {
+cv::Mat draw_matches(const vo::StereoFrame& frame, std::span<const vo::MatchInfo> matches) {
   cv::Mat gray, out;
   cv::vconcat(frame.left, frame.right, gray);
   cv::cvtColor(gray, out, cv::COLOR_GRAY2BGR);
@@ -200,15 +199,8 @@ std::string report_tracking(const std::vector<Track>& tracks, const Trajectory& 
 void report_filter_counts(const std::vector<Track>& tracks, nlohmann::json* metrics,
                           std::vector<std::string>* warnings) {
   for (const Track& tr : tracks) {
-    FilterCounts c;
-    if (tr.filter) {
-      c = tr.filter->counts();
-    } else if (tr.smoother) {
-      c.nonfinite_guards = tr.smoother->nonfinite_guards();
-      c.counts = {{"nonfinite_guards", c.nonfinite_guards}};
-    } else {
-      continue;
-    }
+    if (!tr.filter) continue;
+    const FilterCounts c = tr.filter->counts();
     (*metrics)["algorithms"][tr.name]["filter"] = c.counts;
     if (c.nonfinite_guards > 0)
       warnings->push_back(fmt::format(
@@ -254,9 +246,10 @@ std::string compare_filters_with_raw_vo(const std::vector<Track>& tracks, nlohma
 
 // The VO tracks of pipeline.vo (every frame "dropped" until it comes), then for each fusion
 // algorithm one track per VO, following it.
+// `T_W_C0`: the anchor, the true pose of the first delivered frame.
 std::vector<Track> make_tracks(const Scenario& sc, const StereoRig& rig,
                                const SensorData& sensor_data, const Trajectory& camera_gt,
-                               const RngStreams& rng) {
+                               const SE3& T_W_C0, const RngStreams& rng) {
   std::vector<Track> tracks;
   for (const std::string& a : sc.pipeline.vo) {
     Track t;
@@ -273,14 +266,9 @@ std::vector<Track> make_tracks(const Scenario& sc, const StereoRig& rig,
     for (std::size_t i = 0; i < n_vo; ++i) {
       Track t;
       t.source = i;
-      if (f == FusionAlgorithm::kCaSmoother) {
-        t.name = tracks[i].name + "_ca";
-        t.smoother =
-            std::make_unique<fusion::ConstantAccelerationSmoother>(sc.pipeline.ca_smoother);
-      } else {
-        t.name = tracks[i].name + "_" + std::string(yaml::enum_name(f));
-        t.filter = std::make_unique<FilterTrack>(f, sc, sensor_data, T_W_B0, rng);
-      }
+      t.name = tracks[i].name + "_" +
+               (f == FusionAlgorithm::kCaSmoother ? "ca" : std::string(yaml::enum_name(f)));
+      t.filter = std::make_unique<FilterTrack>(f, sc, sensor_data, T_W_B0, T_W_C0, rng);
       tracks.push_back(std::move(t));
     }
   }
@@ -318,10 +306,9 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
       ft.columns[1].push_back(rad2deg(platform[k].pitch_rad));
       ft.columns[2].push_back(rad2deg(platform[k].roll_rad));
       const vo::VoResult& r = src.results[k];
-      // Covariate f: inlier features (sparse, river paper Table 4), pixels with valid depth
-      // (dense).
-      const double f = src.name == "dense" ? r.valid_depth_pixels : r.inliers;
-      ft.columns[3].push_back(r.valid ? f : std::numeric_limits<double>::quiet_NaN());
+      // Covariate f as the VO counts its features (river paper Table 4).
+      ft.columns[3].push_back(r.valid ? r.feature_count()
+                                      : std::numeric_limits<double>::quiet_NaN());
       ft.columns[4].push_back(r.valid ? r.mean_inlier_depth_m
                                       : std::numeric_limits<double>::quiet_NaN());
       ft.columns[5].push_back(lost_track(r) ? 1.0 : 0.0);
@@ -383,17 +370,13 @@ void advance_track(Track* track, std::size_t k, bool first, TimeNs t, const vo::
     tr.results[k] = r;
     tr.vo_ms += r.times.total_ms;
   }
-  if (first) {
-    if (tr.smoother) tr.smoother->update(t, r);  // starts the clock
-    if (tr.filter) tr.filter->step(t, r);        // starts from the anchor
+  if (tr.filter) {
+    const SE3 T_W_C = tr.filter->step(t, r);  // the first starts from the anchor
+    if (!first) tr.estimate.push_back({t, T_W_C});
     return;
   }
-  if (tr.filter) {  // absolute poses, not increments
-    tr.estimate.push_back({t, tr.filter->step(t, r)});
-    return;
-  }
-  SE3 step = r.valid ? r.T_prev_curr : SE3();
-  if (tr.smoother) step = tr.smoother->update(t, r).T_prev_curr;
+  if (first) return;
+  const SE3 step = r.valid ? r.T_prev_curr : SE3();
   tr.estimate.push_back({t, tr.estimate.back().T_W_C * step});  // river paper Eq. (3)
 }
 
@@ -430,40 +413,21 @@ sim::SceneGeometry scene_for_track(const Scenario& sc, const Trajectory& camera_
   return scenes::build_scene(sc.scene, sc.seed, north_min, north_max);
 }
 
-static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scene,
-                              const SensorData& sensor_data, const MissionTruth& mission,
-                              const std::filesystem::path& dir, const RunOptions& options,
-                              RunSummary* summary, nlohmann::json* metrics) {
+namespace {
+
+// The frame loop: every delivered frame through every track (VOs, then the filters following
+// them), a frames.csv row each, the exports for the external VOs. Returns the render seconds.
+double run_frame_loop(FrameSource& source, const std::vector<sim::SampleTime>& stamps,
+                      const MissionTruth& mission, std::size_t first,
+                      const std::filesystem::path& dir, const RunOptions& options,
+                      ExternalVoStage* external, std::vector<Track>* tracks_io) {
+  std::vector<Track>& tracks = *tracks_io;
   const Trajectory& camera_gt = mission.camera_gt;
   const std::vector<EulerZYX>& platform = mission.platform;
-  const RngStreams rng(sc.seed);
-  const StereoRig rig = rig_of(sc.sensors.camera);
-  // The camera's clock: stamps (offset, jitter) and dropped frames.
-  const std::vector<sim::SampleTime> stamps =
-      sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
-  DRIFTLAB_DEMAND_MSG(stamps.size() >= camera_gt.size(), "camera clock: fewer stamps than frames");
-  // Stage: render and camera effects (the scene built once, uploaded once), on a thread of
-  // their own when the run has more than one.
-  const int threads = run_threads(sc.pipeline.threads);
-  ExternalVoStage external(sc, dir);  // exports of the frames for the external VOs
-  FrameSource source(sc, scene, mission.frames, stamps, threads, 4, external.wants_depth());
-  (*metrics)["timing"]["threads"] = threads;
-
-  // Stages: VO and fusion. VO sees images and the rig only; the pipeline
-  // anchors every estimate at the true first pose so that tracks overlay.
-  std::vector<Track> tracks = make_tracks(sc, rig, sensor_data, camera_gt, rng);
-  std::vector<std::string> warnings = implausible_values(sc);
-  const std::size_t n_vo = sc.pipeline.vo.size();
-  std::size_t first = 0;  // the first frame the camera delivers
-  while (first < stamps.size() && first < camera_gt.size() && stamps[first].dropped) ++first;
-  if (first < camera_gt.size())
-    for (auto& t : tracks) t.estimate.push_back({stamps[first].t_stamp_ns, camera_gt[first].T_W_C});
-  std::size_t dropped = 0;
-  for (std::size_t k = 0; k < camera_gt.size(); ++k) dropped += stamps[k].dropped ? 1 : 0;
-
   AtomicFile frames_csv(dir / "frames.csv");
   std::string header = "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms,exposure_ms";
-  for (std::size_t i = 0; i < n_vo; ++i) header += vo_csv_header(tracks[i].name);
+  for (const Track& tr : tracks)
+    if (tr.vo) header += vo_csv_header(tr.name);
   frames_csv.write(header + "\n");
   double render_s = 0;
   Progress progress(options.progress, "render+vo", camera_gt.size(), options.progress_tty);
@@ -486,45 +450,102 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
                                   render_ms, yaml::format_double(exposure_ms));
     for (Track& tr : tracks) {
       const vo::VoResult r = tr.vo ? tr.vo->process(frame) : tracks[tr.source].results[k];
-      if (k == sample_frame && tr.vo && r.valid) {
-        if (const auto* sparse = dynamic_cast<const vo::SparseStereoOdometry*>(tr.vo.get()))
-          cv::imwrite((dir / "plots" / (tr.name + "_matches.png")).string(),
-                      draw_matches(frame, sparse->last_matches()));
-      }
+      if (k == sample_frame && tr.vo && r.valid && !tr.vo->last_matches().empty())
+        cv::imwrite((dir / "plots" / (tr.name + "_matches.png")).string(),
+                    draw_matches(frame, tr.vo->last_matches()));
       if (tr.vo) row += vo_csv_cells(r);
       advance_track(&tr, k, k == first, t, r);
     }
     frames_csv.write(row + "\n");
-    external.add_frame(t, img, camera_gt[k]);
+    external->add_frame(t, img, camera_gt[k]);
   }
   progress.update(camera_gt.size());
   progress.finish();
   frames_csv.commit();
-  // The smoother's Rauch-Tung-Striebel pass over the whole run: NAME_ca_rts estimates.
+  return render_s;
+}
+
+// The tracks that follow the frame loop: the smoother's Rauch-Tung-Striebel pass over the
+// whole run (NAME_ca_rts) and the external VOs, run on the exports of the same frames.
+void add_whole_run_tracks(const Scenario& sc, const std::vector<sim::SampleTime>& stamps,
+                          std::size_t first, const MissionTruth& mission, ExternalVoStage* external,
+                          std::vector<Track>* tracks, nlohmann::json* metrics,
+                          std::vector<std::string>* warnings) {
   const auto& fusion = sc.pipeline.fusion;
   if (sc.pipeline.ca_smoother.rts_backward_pass &&
       std::find(fusion.begin(), fusion.end(), FusionAlgorithm::kCaSmoother) != fusion.end())
-    for (std::size_t i = 0; i < n_vo; ++i)
-      tracks.push_back(rts_smoothed(tracks[i], i, stamps, first, sc.pipeline.ca_smoother));
-  // Stage: external VOs, on the exports of the same frames.
-  for (ExternalVoResult& r : external.finish(mission.imu_states)) {
+    for (std::size_t i = 0; i < sc.pipeline.vo.size(); ++i)
+      tracks->push_back(rts_smoothed((*tracks)[i], i, stamps, first, sc.pipeline.ca_smoother));
+  for (ExternalVoResult& r : external->finish(mission.imu_states)) {
     (*metrics)["external_vo"][r.name] = r.record;
-    if (!r.warning.empty()) warnings.push_back(r.warning);
+    if (!r.warning.empty()) warnings->push_back(r.warning);
     if (!r.ok) continue;
     Track t;
     t.name = r.name;
     t.external = true;
     t.estimate = std::move(r.estimate);
-    t.results.resize(camera_gt.size());
+    t.results.resize(mission.camera_gt.size());
     for (auto& v : t.results) v.reason = "external VO: no per-frame statistics";
-    tracks.push_back(std::move(t));
+    tracks->push_back(std::move(t));
   }
+}
+
+void write_estimates(const std::vector<Track>& tracks, const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir / "estimates");
   for (const auto& tr : tracks) {
     write_tum(dir / "estimates" / (tr.name + ".tum"), tr.estimate);
     if (tr.filter && tr.filter->writes_states())
       tr.filter->write_states(dir / "estimates" / (tr.name + ".csv"));
   }
+}
+
+// metrics.json's camera block: frames delivered and dropped, and the effects that were on.
+nlohmann::json camera_metrics(const Scenario& sc, std::size_t frames, std::size_t dropped) {
+  const auto& cam = sc.sensors.camera;
+  return {{"frames_delivered", frames - dropped},
+          {"frames_dropped", dropped},
+          {"noise", cam.noise.enabled},
+          {"vignetting_strength", cam.vignetting_strength},
+          {"motion_blur_samples", sc.render.motion_blur_samples},
+          {"lens_distortion", cam.lens_distortion.enabled},
+          {"clock_offset_ms", cam.clock.offset_ms}};
+}
+
+}  // namespace
+
+static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scene,
+                              const SensorData& sensor_data, const MissionTruth& mission,
+                              const std::filesystem::path& dir, const RunOptions& options,
+                              RunSummary* summary, nlohmann::json* metrics) {
+  const Trajectory& camera_gt = mission.camera_gt;
+  const RngStreams rng(sc.seed);
+  // The camera's clock: stamps (offset, jitter) and dropped frames.
+  const std::vector<sim::SampleTime> stamps =
+      sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
+  DRIFTLAB_DEMAND_MSG(stamps.size() >= camera_gt.size(), "camera clock: fewer stamps than frames");
+  // Stage: render and camera effects (the scene built once, uploaded once), on a thread of
+  // their own when the run has more than one.
+  const int threads = run_threads(sc.pipeline.threads);
+  ExternalVoStage external(sc, dir);  // exports of the frames for the external VOs
+  FrameSource source(sc, scene, mission.frames, stamps, threads, 4, external.wants_depth());
+  (*metrics)["timing"]["threads"] = threads;
+
+  // Stages: VO and fusion. VO sees images and the rig only; the pipeline
+  // anchors every estimate at the true first pose so that tracks overlay.
+  std::size_t first = 0;  // the first frame the camera delivers
+  while (first < stamps.size() && first < camera_gt.size() && stamps[first].dropped) ++first;
+  const SE3 T_W_C0 = first < camera_gt.size() ? camera_gt[first].T_W_C : SE3();
+  std::vector<Track> tracks =
+      make_tracks(sc, rig_of(sc.sensors.camera), sensor_data, camera_gt, T_W_C0, rng);
+  std::vector<std::string> warnings = implausible_values(sc);
+  if (first < camera_gt.size())
+    for (auto& t : tracks) t.estimate.push_back({stamps[first].t_stamp_ns, camera_gt[first].T_W_C});
+  std::size_t dropped = 0;
+  for (std::size_t k = 0; k < camera_gt.size(); ++k) dropped += stamps[k].dropped ? 1 : 0;
+  const double render_s =
+      run_frame_loop(source, stamps, mission, first, dir, options, &external, &tracks);
+  add_whole_run_tracks(sc, stamps, first, mission, &external, &tracks, metrics, &warnings);
+  write_estimates(tracks, dir);
 
   // Stage: evaluation of every estimate against the camera ground truth.
   std::string report = fmt::format("# driftlab run: {}\n\n{}\n\n", sc.name, sc.description);
@@ -535,18 +556,12 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   report += compare_filters_with_raw_vo(tracks, metrics, &warnings);
   report_filter_counts(tracks, metrics, &warnings);
 
-  write_report(sc, tracks, camera_gt, dir, sample_frame, sections, report, *metrics, &warnings);
+  write_report(sc, tracks, camera_gt, dir, camera_gt.size() / 2, sections, report, *metrics,
+               &warnings);
   (*metrics)["timing"]["render_s"] = render_s;
   (*metrics)["timing"]["render_pairs_per_s"] =
       render_s > 0 ? static_cast<double>(camera_gt.size() - dropped) / render_s : 0.0;
-  const auto& cam = sc.sensors.camera;
-  (*metrics)["camera"] = {{"frames_delivered", camera_gt.size() - dropped},
-                          {"frames_dropped", dropped},
-                          {"noise", cam.noise.enabled},
-                          {"vignetting_strength", cam.vignetting_strength},
-                          {"motion_blur_samples", sc.render.motion_blur_samples},
-                          {"lens_distortion", cam.lens_distortion.enabled},
-                          {"clock_offset_ms", cam.clock.offset_ms}};
+  (*metrics)["camera"] = camera_metrics(sc, camera_gt.size(), dropped);
   (*metrics)["warnings"] = warnings;
   (*metrics)["render"] = {{"context", source.info().context},
                           {"triangles", source.info().triangles}};

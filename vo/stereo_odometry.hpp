@@ -2,6 +2,7 @@
 // A VO sees rectified stereo pairs and the rig only, never ground truth (DESIGN.md).
 #pragma once
 
+#include <span>
 #include <string>
 
 #include <opencv2/core/mat.hpp>
@@ -47,15 +48,30 @@ struct VoResult {
       0.0;                     ///< mean optical-axis depth of the inliers, current frame [m]
                                ///< (dense: of the pixels used; covariate d of the river paper)
   int valid_depth_pixels = 0;  ///< dense VO: pixels with a valid depth in the depth map the motion
-                               ///< was estimated from (covariate f of the river paper); others: 0
+                               ///< was estimated from; others: 0
+  int features = -1;           ///< covariate f of the river paper (Table 4) as this VO counts its
+                      ///< features: the dense VO sets its valid-depth pixels; -1 (not set):
+                      ///< the inliers, as for the feature VOs. Read it with feature_count().
   int reference_frames_back = 1;  ///< how many frames before this one the frame was that the
                                   ///< motion was measured from (1: the previous frame; more
                                   ///< with keyframes); T_prev_curr is still relative to the
                                   ///< previous frame
   VoStageTimes times;
 
+  /// Covariate f: `features` when the VO set it, the inliers otherwise.
+  int feature_count() const { return features >= 0 ? features : inliers; }
   /// One line for logs: "valid, 212/240 inliers, depth 7.3 m, 3.1 ms" or the reason.
   std::string brief() const;
+};
+
+/// A match as the last process() call used it (diagnostics, the river paper's Fig. 3, tests):
+/// pixels [px].
+struct MatchInfo {
+  double u_lc = 0, v_lc = 0;  ///< current left
+  double u_rc = 0;            ///< current right (row v_lc)
+  double u_lp = 0, v_lp = 0;  ///< previous left
+  double u_rp = 0;            ///< previous right (row v_lp)
+  bool inlier = false;
 };
 
 /// A stereo visual odometry. Implementations are stateful (they keep the previous frame) and
@@ -73,6 +89,9 @@ class StereoOdometry {
   virtual void reset() = 0;
   /// Short identifier, as in scenario files and estimate file names ("sparse").
   virtual std::string name() const = 0;
+  /// The feature matches of the last process() call, for drawing; empty for a VO without
+  /// discrete matches (dense) or that does not report them.
+  virtual std::span<const MatchInfo> last_matches() const { return {}; }
 };
 
 /// Global pose update of river paper Eq. (3), H_hat <- H_hat * H: the pose of the current

@@ -161,6 +161,7 @@ VoResult DenseStereoOdometry::process(const StereoFrame& frame) {
   if (!s.has_previous) return finish("first frame");
   const Impl::FrameData& prev = *s.prev;
   result.valid_depth_pixels = prev.ref.valid_depth_pixels;
+  result.features = result.valid_depth_pixels;  // covariate f: pixels with depth (Table 4)
   s.stats.reference_points = static_cast<int>(prev.ref.levels.back().size());
   if (cur.ref.textured_pixels < s.options.min_textured_pixels)
     return finish("too little texture in the current left image (black, flat or water?)");

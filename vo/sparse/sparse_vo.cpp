@@ -252,7 +252,7 @@ SparseStereoOdometry::~SparseStereoOdometry() = default;
 
 const SparseVoOptions& SparseStereoOdometry::options() const { return impl_->options; }
 
-std::span<const SparseMatchInfo> SparseStereoOdometry::last_matches() const { return impl_->infos; }
+std::span<const MatchInfo> SparseStereoOdometry::last_matches() const { return impl_->infos; }
 
 int SparseStereoOdometry::last_feature_count() const {
   return static_cast<int>(impl_->l0.all.features.size());

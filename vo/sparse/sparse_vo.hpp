@@ -22,14 +22,8 @@
 
 namespace driftlab::vo {
 
-/// A match as the last process() call used it (diagnostics and tests): pixels [px].
-struct SparseMatchInfo {
-  double u_lc = 0, v_lc = 0;  ///< current left
-  double u_rc = 0;            ///< current right (row v_lc)
-  double u_lp = 0, v_lp = 0;  ///< previous left
-  double u_rp = 0;            ///< previous right (row v_lp)
-  bool inlier = false;
-};
+/// The sparse VO's matches are StereoOdometry's MatchInfo.
+using SparseMatchInfo = MatchInfo;
 
 /// The sparse VO. Not thread-safe; one instance per stream of frames.
 class SparseStereoOdometry final : public StereoOdometry {
@@ -46,7 +40,7 @@ class SparseStereoOdometry final : public StereoOdometry {
 
   const SparseVoOptions& options() const;
   /// The bucketed circle matches handed to the estimator by the last process() call.
-  std::span<const SparseMatchInfo> last_matches() const;
+  std::span<const MatchInfo> last_matches() const override;
   /// Features detected in the last left image (diagnostics).
   int last_feature_count() const;
 
