@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "tests/vo/vo_test_sequences.hpp"
@@ -234,6 +236,25 @@ TYPED_TEST(StereoOdometryTest, StatisticsAreConsistent) {
   EXPECT_GE(r.times.total_ms, r.times.detect_ms);
   EXPECT_GE(r.times.total_ms, r.times.match_ms + r.times.estimate_ms);
   EXPECT_NE(r.brief().find("valid"), std::string::npos);
+}
+
+// The result carries its own covariate f (river paper Table 4): pixels with depth for a VO that
+// reports a depth map, the inliers otherwise; a VO that reports its matches flags as many
+// inliers as it counts.
+TYPED_TEST(StereoOdometryTest, CarriesItsOwnCovariateFAndMatches) {
+  const test::Sequence& seq = straight_640();
+  auto vo = TypeParam::make(seq.rig);
+  vo->process(seq.frames[0]);
+  const VoResult r = vo->process(seq.frames[1]);
+  ASSERT_TRUE(r.valid) << r.reason;
+  EXPECT_EQ(r.feature_count(), r.valid_depth_pixels > 0 ? r.valid_depth_pixels : r.inliers);
+  EXPECT_GT(r.feature_count(), 20);
+  const auto matches = vo->last_matches();
+  if (!matches.empty()) {
+    const auto flagged =
+        std::count_if(matches.begin(), matches.end(), [](const MatchInfo& m) { return m.inlier; });
+    EXPECT_EQ(flagged, r.inliers);
+  }
 }
 
 TYPED_TEST(StereoOdometryTest, BlackFrameIsInvalidWithReason) {
