@@ -26,6 +26,11 @@ class NedFilterAdapter final : public Filter {
     const double dt = started_ ? static_cast<double>(t_ns - t_prev_ns_) * 1e-9 : 0.0;
     started_ = true;
     t_prev_ns_ = t_ns;
+    // body_velocity_from_vo() makes a non-finite increment an invalid measurement; counted
+    // here, as every filter counts the non-finite inputs it skips.
+    if (result.valid && !(result.T_prev_curr.translation().allFinite() &&
+                          result.T_prev_curr.quaternion().coeffs().allFinite()))
+      ++nonfinite_inputs_;
     const BodyVelocityMeasurement m = body_velocity_from_vo(t_ns, dt, result, T_B_C_);
     const NedEstimate e = filter_.step(m, heading_);
     heading_.reset();
@@ -41,7 +46,7 @@ class NedFilterAdapter final : public Filter {
       resampled += e.resampled;
     }
     FilterSummary s;
-    s.nonfinite_guards = filter_.nonfinite_guards();
+    s.nonfinite_guards = filter_.nonfinite_guards() + nonfinite_inputs_;
     s.counts = {{"steps", static_cast<std::int64_t>(states_.size())},
                 {"vo_fused", vo},
                 {"heading_fused", heading}};
@@ -60,6 +65,7 @@ class NedFilterAdapter final : public Filter {
   TimeNs t_prev_ns_ = 0;
   std::optional<HeadingMeasurement> heading_;
   std::vector<NedEstimate> states_;
+  std::int64_t nonfinite_inputs_ = 0;
 };
 
 // The ESKF: every measurement at its time; one taken before the filter's time (before the
