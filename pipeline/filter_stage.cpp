@@ -16,57 +16,73 @@ namespace driftlab::pipeline {
 
 namespace {
 
-std::unique_ptr<fusion::Filter> make_ned_filter(FusionAlgorithm kind, const Scenario& sc,
+std::unique_ptr<fusion::Filter> make_ned_filter(FusionAlgorithm kind, const PipelineOptions& p,
+                                                const FilterMounts& mounts,
                                                 const SensorData& sensors, const SE3& T_W_B0,
                                                 const RngStreams& rng, const std::string& who) {
   if (sensors.compass.empty())
     throw UserError(who + " needs the compass (sensors.compass.enabled: true)");
-  const SE3 T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
   fusion::NedState init;
   init.north_m = T_W_B0.translation().x();
   init.east_m = T_W_B0.translation().y();
   init.heading_rad = sensors.compass.front().heading_rad;  // measured, not the truth
   if (kind == FusionAlgorithm::kNedKf)
-    return fusion::make_ned_kalman_filter(sc.pipeline.ned_kf, init, T_B_C);
-  return fusion::make_ned_particle_filter(sc.pipeline.ned_pf, rng.stream("fusion.ned_pf"), init,
-                                          T_B_C);
+    return fusion::make_ned_kalman_filter(p.ned_kf, init, mounts.T_B_C);
+  return fusion::make_ned_particle_filter(p.ned_pf, rng.stream("fusion.ned_pf"), init,
+                                          mounts.T_B_C);
 }
 
-std::unique_ptr<fusion::Filter> make_eskf_filter(const Scenario& sc, const SensorData& sensors,
-                                                 const SE3& T_W_B0, const std::string& who) {
+std::unique_ptr<fusion::Filter> make_eskf_filter(const PipelineOptions& p,
+                                                 const FilterMounts& mounts,
+                                                 const SensorData& sensors, const SE3& T_W_B0,
+                                                 const std::string& who) {
   if (sensors.imu.empty()) throw UserError(who + " needs the IMU (sensors.imu.enabled: true)");
-  const SE3 T_B_I = sim::SensorMount::from_options(sc.sensors.imu.mount).T_B_S();
-  const Mat3 R_B_M = sim::SensorMount::from_options(sc.sensors.compass.mount).R_B_S;
-  const auto& a = sc.sensors.gps.antenna_frd_m;
+  const SE3& T_B_I = mounts.T_B_I;
   fusion::EskfExtrinsics ex;
-  ex.T_I_C = T_B_I.inverse() * camera_mount_T_B_C(sc.sensors.camera.mount);
-  ex.p_I_antenna_m = T_B_I.inverse() * Vec3(a[0], a[1], a[2]);
-  ex.R_I_M = T_B_I.rotation().transpose() * R_B_M;
+  ex.T_I_C = T_B_I.inverse() * mounts.T_B_C;
+  ex.p_I_antenna_m = T_B_I.inverse() * mounts.p_B_antenna_m;
+  ex.R_I_M = T_B_I.rotation().transpose() * mounts.R_B_M;
   const ImuSample& imu0 = sensors.imu.front();
-  const double heading0 = sensors.compass.empty() ? 0.0 : sensors.compass.front().heading_rad;
+  const SE3 T_W_I0 = T_W_B0 * T_B_I;
+  // Without a compass, the heading of the compass frame's x axis at the anchor.
+  const Vec3 x_M = T_W_I0.rotation() * ex.R_I_M.col(0);
+  const double heading0 =
+      sensors.compass.empty() ? std::atan2(x_M.y(), x_M.x()) : sensors.compass.front().heading_rad;
   fusion::EskfState init;
   init.t_ns = imu0.t_ns;
   init.q_W_I = fusion::attitude_from_gravity_and_heading(imu0.accel_m_s2, heading0, ex.R_I_M);
-  init.p_W_m = (T_W_B0 * T_B_I).translation();
-  return fusion::make_eskf(sc.pipeline.eskf, ex, init);
+  init.p_W_m = T_W_I0.translation();
+  return fusion::make_eskf(p.eskf, ex, init);
 }
 
 }  // namespace
 
-FilterTrack::FilterTrack(FusionAlgorithm kind, const Scenario& sc, const SensorData& sensors,
-                         const SE3& T_W_B0, const SE3& T_W_C0, const RngStreams& rng)
-    : kind_(kind), sensors_(&sensors), gps_sigma_h_(sc.sensors.gps.sigma_horizontal_m) {
+FilterMounts filter_mounts(const Scenario& sc) {
+  FilterMounts m;
+  m.T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
+  m.T_B_I = sim::SensorMount::from_options(sc.sensors.imu.mount).T_B_S();
+  m.R_B_M = sim::SensorMount::from_options(sc.sensors.compass.mount).R_B_S;
+  const auto& a = sc.sensors.gps.antenna_frd_m;
+  m.p_B_antenna_m = Vec3(a[0], a[1], a[2]);
+  m.gps_sigma_horizontal_m = sc.sensors.gps.sigma_horizontal_m;
+  return m;
+}
+
+FilterTrack::FilterTrack(FusionAlgorithm kind, const PipelineOptions& options,
+                         const FilterMounts& mounts, const SensorData& sensors, const SE3& T_W_B0,
+                         const SE3& T_W_C0, const RngStreams& rng)
+    : kind_(kind), sensors_(&sensors), gps_sigma_h_(mounts.gps_sigma_horizontal_m) {
   const std::string who = "pipeline.fusion: " + std::string(yaml::enum_name(kind));
   switch (kind) {
     case FusionAlgorithm::kCaSmoother:
-      filter_ = fusion::make_ca_smoother(sc.pipeline.ca_smoother, T_W_C0);
+      filter_ = fusion::make_ca_smoother(options.ca_smoother, T_W_C0);
       break;
     case FusionAlgorithm::kNedKf:
     case FusionAlgorithm::kNedPf:
-      filter_ = make_ned_filter(kind, sc, sensors, T_W_B0, rng, who);
+      filter_ = make_ned_filter(kind, options, mounts, sensors, T_W_B0, rng, who);
       break;
     case FusionAlgorithm::kEskf:
-      filter_ = make_eskf_filter(sc, sensors, T_W_B0, who);
+      filter_ = make_eskf_filter(options, mounts, sensors, T_W_B0, who);
       break;
   }
   DRIFTLAB_DEMAND_MSG(filter_ != nullptr, "FilterTrack: a fusion algorithm without a filter");

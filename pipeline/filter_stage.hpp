@@ -27,12 +27,28 @@ struct FilterCounts {
   nlohmann::ordered_json counts;  // every counter of the filter, nonfinite_guards included
 };
 
+/// Where the sensors sit on the body frame B (the frame whose pose is the anchor, and the NED
+/// filters' vessel body), and the GPS's horizontal error: what a filter knows of the platform.
+struct FilterMounts {
+  SE3 T_B_C;                          ///< left camera, OpenCV optical frame
+  SE3 T_B_I;                          ///< IMU
+  Mat3 R_B_M = Mat3::Identity();      ///< compass sensor axes
+  Vec3 p_B_antenna_m = Vec3::Zero();  ///< GPS antenna phase centre
+  double gps_sigma_horizontal_m = 1.5;
+};
+
+/// The mounts of a scenario's sensors (sensors.*.mount, sensors.gps.antenna_frd_m).
+FilterMounts filter_mounts(const Scenario& sc);
+
 class FilterTrack {
  public:
+  /// `options`: the filters' options (pipeline.ca_smoother, ned_kf, ned_pf, eskf);
   /// `T_W_B0`: the anchor, the body pose at the first frame; `T_W_C0`: the left camera's pose
-  /// there (where the smoother's chain starts).
-  FilterTrack(FusionAlgorithm kind, const Scenario& sc, const SensorData& sensors,
-              const SE3& T_W_B0, const SE3& T_W_C0, const RngStreams& rng);
+  /// there (where the smoother's chain starts). The ESKF's heading comes from the first compass
+  /// sample, or from the anchor when there is no compass (as its position does).
+  FilterTrack(FusionAlgorithm kind, const PipelineOptions& options, const FilterMounts& mounts,
+              const SensorData& sensors, const SE3& T_W_B0, const SE3& T_W_C0,
+              const RngStreams& rng);
   ~FilterTrack();
   FilterTrack(FilterTrack&&) noexcept;
 

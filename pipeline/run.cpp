@@ -25,6 +25,7 @@
 #include "pipeline/scenario_checks.hpp"
 #include "pipeline/sensor_stage.hpp"
 #include "pipeline/tracking.hpp"
+#include "pipeline/tracks.hpp"
 #include "pipeline/vo_stage.hpp"
 #include "report/run_report.hpp"
 #include "scenes/build_scene.hpp"
@@ -146,18 +147,6 @@ sim::MotionSummary simulate_scenario_motion(
 
 namespace {
 
-// One estimate stream: a VO, or a filter following one (fusion::Filter), or an external VO.
-struct Track {
-  std::string name;
-  std::unique_ptr<vo::StereoOdometry> vo;
-  std::unique_ptr<FilterTrack> filter;  // NAME_ca, NAME_ned_kf, NAME_ned_pf, NAME_eskf streams
-  std::size_t source = 0;               // for a smoothed stream: the VO track it follows
-  bool external = false;                // an external VO's estimate (pipeline.external_vo)
-  Trajectory estimate;
-  std::vector<vo::VoResult> results;  // per frame time; a dropped frame's is invalid
-  double vo_ms = 0;
-};
-
 // Fig. 3 of the river paper: the current left image above the right one, each match's
 // points joined across the pair, its flow from the previous frame drawn in the left image.
 cv::Mat draw_matches(const vo::StereoFrame& frame, std::span<const vo::MatchInfo> matches) {
@@ -194,56 +183,6 @@ std::string report_tracking(const std::vector<Track>& tracks, const Trajectory& 
   return names.empty() ? "" : tracking_table_markdown(names, summaries);
 }
 
-// What each filter and smoother did (algorithms.NAME.filter: measurements fused, skipped,
-// gated; non-finite guards), and a warning for every guard that fired.
-void report_filter_counts(const std::vector<Track>& tracks, nlohmann::json* metrics,
-                          std::vector<std::string>* warnings) {
-  for (const Track& tr : tracks) {
-    if (!tr.filter) continue;
-    const FilterCounts c = tr.filter->counts();
-    (*metrics)["algorithms"][tr.name]["filter"] = c.counts;
-    if (c.nonfinite_guards > 0)
-      warnings->push_back(fmt::format(
-          "{}: {} non-finite inputs or states were caught (skipped, or the filter restarted); "
-          "see algorithms.{}.filter in metrics.json",
-          tr.name, c.nonfinite_guards, tr.name));
-  }
-}
-
-// Each filter's estimate against its raw VO's, by APE translation RMSE (the same evaluation,
-// the same frames): `vs_raw_vo` in the filter's metrics, a report table, and a warning for each
-// filter that is worse than the VO it filters, so that a filter that does not help says so.
-std::string compare_filters_with_raw_vo(const std::vector<Track>& tracks, nlohmann::json* metrics,
-                                        std::vector<std::string>* warnings) {
-  std::string table;
-  for (const Track& tr : tracks) {
-    if (tr.vo || tr.external) continue;
-    const std::string& raw = tracks[tr.source].name;
-    auto& algorithms = (*metrics)["algorithms"];
-    const auto& f = algorithms[tr.name]["ape"]["trans_m"]["rmse"];
-    const auto& r = algorithms[raw]["ape"]["trans_m"]["rmse"];
-    if (!f.is_number() || !r.is_number()) continue;  // no associated poses
-    const double filtered_m = f.get<double>(), raw_m = r.get<double>();
-    const bool better = filtered_m < raw_m;
-    algorithms[tr.name]["vs_raw_vo"] = {{"raw_vo", raw},
-                                        {"metric", "ape.trans_m.rmse"},
-                                        {"filtered", filtered_m},
-                                        {"raw", raw_m},
-                                        {"ratio", raw_m > 0 ? filtered_m / raw_m : 0.0},
-                                        {"better", better}};
-    if (!better)
-      warnings->push_back(fmt::format(
-          "{} is no better than its raw VO {}: APE translation RMSE {:.4g} m against {:.4g} m",
-          tr.name, raw, filtered_m, raw_m));
-    table += fmt::format("| {} | {} | {:.4g} | {:.4g} | {:.2f} | {} |\n", tr.name, raw, filtered_m,
-                         raw_m, raw_m > 0 ? filtered_m / raw_m : 0.0, better ? "yes" : "**no**");
-  }
-  if (table.empty()) return "";
-  return "## Filters against their raw VO\n\n| filter | raw VO | APE trans. RMSE (m) | raw VO's "
-         "(m) | ratio | better |\n|---|---|---|---|---|---|\n" +
-         table + "\n";
-}
-
 // The VO tracks of pipeline.vo (every frame "dropped" until it comes), then for each fusion
 // algorithm one track per VO, following it.
 // `T_W_C0`: the anchor, the true pose of the first delivered frame.
@@ -259,19 +198,16 @@ std::vector<Track> make_tracks(const Scenario& sc, const StereoRig& rig,
     for (auto& r : t.results) r.reason = "frame dropped";
     tracks.push_back(std::move(t));
   }
-  const std::size_t n_vo = tracks.size();
   const SE3 T_W_B0 =
       camera_gt.front().T_W_C * camera_mount_T_B_C(sc.sensors.camera.mount).inverse();
-  for (FusionAlgorithm f : sc.pipeline.fusion) {
-    for (std::size_t i = 0; i < n_vo; ++i) {
-      Track t;
-      t.source = i;
-      t.name = tracks[i].name + "_" +
-               (f == FusionAlgorithm::kCaSmoother ? "ca" : std::string(yaml::enum_name(f)));
-      t.filter = std::make_unique<FilterTrack>(f, sc, sensor_data, T_W_B0, T_W_C0, rng);
-      tracks.push_back(std::move(t));
-    }
-  }
+  const FilterMounts mounts = filter_mounts(sc);
+  add_filter_tracks(
+      sc.pipeline.fusion, tracks.size(),
+      [&](FusionAlgorithm f) {
+        return std::make_unique<FilterTrack>(f, sc.pipeline, mounts, sensor_data, T_W_B0, T_W_C0,
+                                             rng);
+      },
+      &tracks);
   return tracks;
 }
 
@@ -361,47 +297,6 @@ void write_report(const Scenario& sc, const std::vector<Track>& tracks, const Tr
                     report::report_html("driftlab run: " + sc.name, tables, plots));
 }
 
-// One frame of a track: a VO's result is kept; a smoother or filter starts at the first
-// delivered frame and then adds a pose (a filter's absolute pose; otherwise the increment,
-// river paper Eq. (3)).
-void advance_track(Track* track, std::size_t k, bool first, TimeNs t, const vo::VoResult& r) {
-  Track& tr = *track;
-  if (tr.vo) {
-    tr.results[k] = r;
-    tr.vo_ms += r.times.total_ms;
-  }
-  if (tr.filter) {
-    const SE3 T_W_C = tr.filter->step(t, r);  // the first starts from the anchor
-    if (!first) tr.estimate.push_back({t, T_W_C});
-    return;
-  }
-  if (first) return;
-  const SE3 step = r.valid ? r.T_prev_curr : SE3();
-  tr.estimate.push_back({t, tr.estimate.back().T_W_C * step});  // river paper Eq. (3)
-}
-
-// The constant-acceleration smoother with its backward pass over the delivered frames of VO
-// track `track` (index `source`), anchored where the VO's estimate starts.
-Track rts_smoothed(const Track& track, std::size_t source,
-                   const std::vector<sim::SampleTime>& stamps, std::size_t first,
-                   const fusion::CaSmootherOptions& options) {
-  std::vector<TimeNs> t_ns;
-  std::vector<vo::VoResult> results;
-  for (std::size_t k = first; k < track.results.size() && k < stamps.size(); ++k) {
-    if (stamps[k].dropped) continue;
-    t_ns.push_back(stamps[k].t_stamp_ns);
-    results.push_back(track.results[k]);
-  }
-  const fusion::SmoothedTrajectory s = fusion::smooth_trajectory(t_ns, results, options);
-  Track t;
-  t.name = track.name + "_ca_rts";
-  t.source = source;
-  const SE3 T_W_first = track.estimate.front().T_W_C;
-  for (std::size_t j = 0; j < s.t_ns.size(); ++j)
-    t.estimate.push_back({s.t_ns[j], T_W_first * s.T_first_cam[j]});
-  return t;
-}
-
 }  // namespace
 
 sim::SceneGeometry scene_for_track(const Scenario& sc, const Trajectory& camera_gt) {
@@ -471,11 +366,13 @@ void add_whole_run_tracks(const Scenario& sc, const std::vector<sim::SampleTime>
                           std::size_t first, const MissionTruth& mission, ExternalVoStage* external,
                           std::vector<Track>* tracks, nlohmann::json* metrics,
                           std::vector<std::string>* warnings) {
-  const auto& fusion = sc.pipeline.fusion;
-  if (sc.pipeline.ca_smoother.rts_backward_pass &&
-      std::find(fusion.begin(), fusion.end(), FusionAlgorithm::kCaSmoother) != fusion.end())
+  if (runs_backward_pass(sc.pipeline)) {
+    std::vector<std::optional<TimeNs>> delivered(stamps.size());
+    for (std::size_t k = first; k < stamps.size(); ++k)
+      if (!stamps[k].dropped) delivered[k] = stamps[k].t_stamp_ns;
     for (std::size_t i = 0; i < sc.pipeline.vo.size(); ++i)
-      tracks->push_back(rts_smoothed((*tracks)[i], i, stamps, first, sc.pipeline.ca_smoother));
+      tracks->push_back(rts_smoothed((*tracks)[i], i, delivered, sc.pipeline.ca_smoother));
+  }
   for (ExternalVoResult& r : external->finish(mission.imu_states)) {
     (*metrics)["external_vo"][r.name] = r.record;
     if (!r.warning.empty()) warnings->push_back(r.warning);
@@ -487,15 +384,6 @@ void add_whole_run_tracks(const Scenario& sc, const std::vector<sim::SampleTime>
     t.results.resize(mission.camera_gt.size());
     for (auto& v : t.results) v.reason = "external VO: no per-frame statistics";
     tracks->push_back(std::move(t));
-  }
-}
-
-void write_estimates(const std::vector<Track>& tracks, const std::filesystem::path& dir) {
-  std::filesystem::create_directories(dir / "estimates");
-  for (const auto& tr : tracks) {
-    write_tum(dir / "estimates" / (tr.name + ".tum"), tr.estimate);
-    if (tr.filter && tr.filter->writes_states())
-      tr.filter->write_states(dir / "estimates" / (tr.name + ".csv"));
   }
 }
 

@@ -1,0 +1,126 @@
+#include "pipeline/tracks.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "core/yaml_io.hpp"
+
+namespace driftlab::pipeline {
+
+std::string filter_track_name(const std::string& vo, FusionAlgorithm kind) {
+  return vo + "_" +
+         (kind == FusionAlgorithm::kCaSmoother ? "ca" : std::string(yaml::enum_name(kind)));
+}
+
+void add_filter_tracks(const std::vector<FusionAlgorithm>& fusion, std::size_t n_vo,
+                       const std::function<std::unique_ptr<FilterTrack>(FusionAlgorithm)>& make,
+                       std::vector<Track>* tracks) {
+  for (FusionAlgorithm f : fusion) {
+    for (std::size_t i = 0; i < n_vo; ++i) {
+      Track t;
+      t.source = i;
+      t.name = filter_track_name((*tracks)[i].name, f);
+      t.filter = make(f);
+      tracks->push_back(std::move(t));
+    }
+  }
+}
+
+void advance_track(Track* track, std::size_t k, bool first, TimeNs t, const vo::VoResult& r) {
+  Track& tr = *track;
+  if (tr.vo) {
+    tr.results[k] = r;
+    tr.vo_ms += r.times.total_ms;
+  }
+  if (tr.filter) {
+    const SE3 T_W_C = tr.filter->step(t, r);  // the first starts from the anchor
+    if (!first) tr.estimate.push_back({t, T_W_C});
+    return;
+  }
+  if (first) return;
+  const SE3 step = r.valid ? r.T_prev_curr : SE3();
+  tr.estimate.push_back({t, tr.estimate.back().T_W_C * step});  // river paper Eq. (3)
+}
+
+bool runs_backward_pass(const PipelineOptions& pipeline) {
+  const auto& f = pipeline.fusion;
+  return pipeline.ca_smoother.rts_backward_pass &&
+         std::find(f.begin(), f.end(), FusionAlgorithm::kCaSmoother) != f.end();
+}
+
+Track rts_smoothed(const Track& track, std::size_t source,
+                   const std::vector<std::optional<TimeNs>>& delivered,
+                   const fusion::CaSmootherOptions& options) {
+  std::vector<TimeNs> t_ns;
+  std::vector<vo::VoResult> results;
+  for (std::size_t k = 0; k < track.results.size() && k < delivered.size(); ++k) {
+    if (!delivered[k]) continue;
+    t_ns.push_back(*delivered[k]);
+    results.push_back(track.results[k]);
+  }
+  const fusion::SmoothedTrajectory s = fusion::smooth_trajectory(t_ns, results, options);
+  Track t;
+  t.name = track.name + "_ca_rts";
+  t.source = source;
+  const SE3 T_W_first = track.estimate.front().T_W_C;
+  for (std::size_t j = 0; j < s.t_ns.size(); ++j)
+    t.estimate.push_back({s.t_ns[j], T_W_first * s.T_first_cam[j]});
+  return t;
+}
+
+void write_estimates(const std::vector<Track>& tracks, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir / "estimates");
+  for (const auto& tr : tracks) {
+    write_tum(dir / "estimates" / (tr.name + ".tum"), tr.estimate);
+    if (tr.filter && tr.filter->writes_states())
+      tr.filter->write_states(dir / "estimates" / (tr.name + ".csv"));
+  }
+}
+
+void report_filter_counts(const std::vector<Track>& tracks, nlohmann::json* metrics,
+                          std::vector<std::string>* warnings) {
+  for (const Track& tr : tracks) {
+    if (!tr.filter) continue;
+    const FilterCounts c = tr.filter->counts();
+    (*metrics)["algorithms"][tr.name]["filter"] = c.counts;
+    if (c.nonfinite_guards > 0)
+      warnings->push_back(fmt::format(
+          "{}: {} non-finite inputs or states were caught (skipped, or the filter restarted); "
+          "see algorithms.{}.filter in metrics.json",
+          tr.name, c.nonfinite_guards, tr.name));
+  }
+}
+
+std::string compare_filters_with_raw_vo(const std::vector<Track>& tracks, nlohmann::json* metrics,
+                                        std::vector<std::string>* warnings) {
+  std::string table;
+  for (const Track& tr : tracks) {
+    if (tr.vo || tr.external) continue;
+    const std::string& raw = tracks[tr.source].name;
+    auto& algorithms = (*metrics)["algorithms"];
+    const auto& f = algorithms[tr.name]["ape"]["trans_m"]["rmse"];
+    const auto& r = algorithms[raw]["ape"]["trans_m"]["rmse"];
+    if (!f.is_number() || !r.is_number()) continue;  // no associated poses
+    const double filtered_m = f.get<double>(), raw_m = r.get<double>();
+    const bool better = filtered_m < raw_m;
+    algorithms[tr.name]["vs_raw_vo"] = {{"raw_vo", raw},
+                                        {"metric", "ape.trans_m.rmse"},
+                                        {"filtered", filtered_m},
+                                        {"raw", raw_m},
+                                        {"ratio", raw_m > 0 ? filtered_m / raw_m : 0.0},
+                                        {"better", better}};
+    if (!better)
+      warnings->push_back(fmt::format(
+          "{} is no better than its raw VO {}: APE translation RMSE {:.4g} m against {:.4g} m",
+          tr.name, raw, filtered_m, raw_m));
+    table += fmt::format("| {} | {} | {:.4g} | {:.4g} | {:.2f} | {} |\n", tr.name, raw, filtered_m,
+                         raw_m, raw_m > 0 ? filtered_m / raw_m : 0.0, better ? "yes" : "**no**");
+  }
+  if (table.empty()) return "";
+  return "## Filters against their raw VO\n\n| filter | raw VO | APE trans. RMSE (m) | raw VO's "
+         "(m) | ratio | better |\n|---|---|---|---|---|---|\n" +
+         table + "\n";
+}
+
+}  // namespace driftlab::pipeline
