@@ -31,6 +31,11 @@ DatasetCommands::DatasetCommands(CLI::App& app) {
   vo_->add_option("--format", format_, "Dataset layout: kitti or euroc")->capture_default_str();
   vo_->add_option("--algo", algos_, "VO algorithms (default: the settings' pipeline.vo)")
       ->delimiter(',');
+  vo_->add_option("--fusion", fusion_,
+                  "Filters following each VO: ca_smoother, eskf, ned_kf, ned_pf, or none "
+                  "(default: the settings' pipeline.fusion; eskf needs the dataset's IMU, the "
+                  "NED filters a compass)")
+      ->delimiter(',');
   vo_->add_option("--out", out_, "Output folder (written atomically)")->required();
   vo_->add_option("--sequence", sequence_, "KITTI sequence number")->capture_default_str();
   vo_->add_option("--settings", settings_,
@@ -73,6 +78,12 @@ int DatasetCommands::run_vo() {
     for (const auto& a : algos_) list += (list.empty() ? "" : ",") + a;
     sets.push_back("pipeline.vo=[" + list + "]");
   }
+  if (!fusion_.empty()) {  // checked by the scenario reader too
+    std::string list;
+    for (const auto& f : fusion_)
+      if (f != "none") list += (list.empty() ? "" : ",") + f;
+    sets.push_back("pipeline.fusion=[" + list + "]");
+  }
   const auto settings = settings_.empty() ? pipeline::parse_scenario("name: driftlab-vo\n",
                                                                      "built-in defaults", ".", sets)
                                           : pipeline::load_scenario(settings_, sets);
@@ -81,6 +92,7 @@ int DatasetCommands::run_vo() {
   read.sequence = sequence_;
   const dataset::StereoDataset data = dataset::read_dataset(dataset_, format, read);
   pipeline::DatasetRunOptions o;
+  o.fusion_on_command_line = !fusion_.empty();
   o.max_frames = frames_ > 0 ? static_cast<std::size_t>(frames_) : 0;
   o.replace_existing = force_;
   o.progress = stderr;

@@ -30,6 +30,7 @@ class DatasetCommands {
   bool force_ = false;
   std::string dataset_, settings_;
   std::vector<std::string> algos_;
+  std::vector<std::string> fusion_;
 };
 
 }  // namespace driftlab::app

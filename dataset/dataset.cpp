@@ -9,8 +9,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/rotation.hpp"
 #include "core/yaml_io.hpp"
 #include "dataset/dataset_detail.hpp"
 
@@ -100,6 +102,31 @@ std::optional<SE3> pose_at(const Trajectory& trajectory, TimeNs t_ns) {
   const double s =
       static_cast<double>(t_ns - before->t_ns) / static_cast<double>(after->t_ns - before->t_ns);
   return SE3::interpolate_decoupled(before->T_W_C, after->T_W_C, s);
+}
+
+std::vector<CompassReading> read_compass_csv(const fs::path& path) {
+  std::vector<CompassReading> out;
+  for (const detail::TextLine& line : detail::data_lines(path, "compass CSV")) {
+    const std::vector<std::string> cells = split_csv_line(line.text);
+    if (cells.size() != 5)
+      throw UserError(fmt::format(
+          "{}:{}: got {} columns, expected 5 (timestamp [ns], heading [deg], m_S_x, m_S_y, m_S_z "
+          "[nT])",
+          path.string(), line.number, cells.size()));
+    CompassReading r;
+    r.t_ns = detail::parse_stamp_ns(cells[0], path, line.number);
+    const double deg = detail::parse_number(cells[1], path, line.number, "heading");
+    if (!(deg >= 0 && deg < 360))
+      throw UserError(fmt::format("{}:{}: heading: got {}, expected degrees in [0, 360)",
+                                  path.string(), line.number, cells[1]));
+    r.heading_rad = wrap_angle_rad(deg2rad(deg));
+    if (!out.empty() && r.t_ns <= out.back().t_ns)
+      throw UserError(
+          fmt::format("{}:{}: timestamp: got {}, expected more than the line before's {}",
+                      path.string(), line.number, r.t_ns, out.back().t_ns));
+    out.push_back(r);
+  }
+  return out;
 }
 
 namespace detail {

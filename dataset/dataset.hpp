@@ -45,6 +45,13 @@ struct ImuNoiseModel {
   double accelerometer_random_walk = 0;    ///< m/s^3/sqrt(Hz)
 };
 
+/// One compass heading (driftlab's compass.csv: the sensor x axis's heading, clockwise from
+/// north; wrapped to (-pi, pi] here).
+struct CompassReading {
+  TimeNs t_ns = 0;
+  double heading_rad = 0;
+};
+
 /// What a writer needs besides the frames.
 struct ExportCalibration {
   StereoRig rig;  ///< the rectified pair the images are in
@@ -108,7 +115,12 @@ struct StereoDataset {
   std::vector<DatasetFrame> frames;
   Trajectory camera_gt;  ///< left camera; empty when the dataset has none
   std::vector<ImuSample> imu;
+  /// The IMU's Kalibr noise model (EuRoC imu0/sensor.yaml), when the dataset has one.
+  std::optional<ImuNoiseModel> imu_noise;
+  /// Compass headings (a driftlab EuRoC export's mav0/compass0/data.csv); usually empty.
+  std::vector<CompassReading> compass;
   SE3 T_S_C;  ///< rectified left camera in the body frame (identity where unknown)
+  bool has_extrinsics = false;  ///< whether T_S_C comes from the dataset (EuRoC's T_BS)
   /// Set when the images are raw (EuRoC with lens distortion or a rotated right camera): the
   /// pair is rectified as it is read (read_pair) with OpenCV's stereoRectify (zero disparity
   /// at infinity, no black border: alpha 0).
@@ -129,6 +141,10 @@ cv::Mat read_gray(const std::filesystem::path& path);
 
 /// The stereo pair of `frame` as the VOs take it: 8-bit gray, rectified for `data.rig`.
 std::pair<cv::Mat, cv::Mat> read_pair(const StereoDataset& data, const DatasetFrame& frame);
+
+/// driftlab's compass.csv ("#timestamp [ns],heading [deg],m_S_x [nT],m_S_y [nT],m_S_z [nT]",
+/// stamps increasing, headings in [0, 360)); UserError naming the file and line otherwise.
+std::vector<CompassReading> read_compass_csv(const std::filesystem::path& path);
 
 /// The pose of `trajectory` (sorted) at time t: interpolated between the neighbours
 /// (SE3::interpolate_decoupled), or nothing outside its time span.

@@ -203,6 +203,28 @@ CameraYaml camera_from_yaml(const YAML::Node& root, const fs::path& path) {
   return c;
 }
 
+// Kalibr's IMU keys (imu0/sensor.yaml): rate_hz and the four noise parameters.
+ImuNoiseModel read_imu_yaml(const fs::path& path) {
+  const std::string text = read_text_file(path, "EuRoC sensor.yaml");
+  try {
+    const YAML::Node root = YAML::Load(text);
+    const auto number = [&](const char* key) {
+      const YAML::Node n = root.IsMap() ? root[key] : YAML::Node();
+      double x = std::numeric_limits<double>::quiet_NaN();
+      if (n && n.IsScalar()) yaml::parse_double(n.Scalar(), &x);
+      if (!(std::isfinite(x) && x > 0))
+        throw UserError(fmt::format("{}{}: {}: got '{}', expected a number > 0", path.string(),
+                                    n ? fmt::format(":{}", n.Mark().line + 1) : "", key,
+                                    n && n.IsScalar() ? n.Scalar() : "nothing"));
+      return x;
+    };
+    return {number("rate_hz"), number("gyroscope_noise_density"), number("gyroscope_random_walk"),
+            number("accelerometer_noise_density"), number("accelerometer_random_walk")};
+  } catch (const YAML::Exception& e) {
+    throw UserError(fmt::format("{}:{}: {}", path.string(), e.mark.line + 1, e.msg));
+  }
+}
+
 CameraYaml read_camera_yaml(const fs::path& path) {
   const std::string text = read_text_file(path, "EuRoC sensor.yaml");
   try {
@@ -346,7 +368,14 @@ StereoDataset read_euroc(const fs::path& root) {
   if (fs::exists(gt))
     for (const StampedPose& p : read_euroc_groundtruth(gt))
       d.camera_gt.push_back({p.t_ns, p.T_W_C * d.T_S_C});
-  if (fs::exists(mav / "imu0" / "data.csv")) d.imu = read_euroc_imu(mav / "imu0" / "data.csv");
+  d.has_extrinsics = true;
+  if (fs::exists(mav / "imu0" / "data.csv")) {
+    d.imu = read_euroc_imu(mav / "imu0" / "data.csv");
+    if (fs::exists(mav / "imu0" / "sensor.yaml"))
+      d.imu_noise = read_imu_yaml(mav / "imu0" / "sensor.yaml");
+  }
+  if (fs::exists(mav / "compass0" / "data.csv"))
+    d.compass = read_compass_csv(mav / "compass0" / "data.csv");
   return d;
 }
 

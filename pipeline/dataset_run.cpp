@@ -2,15 +2,22 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.hpp"
 #include "core/rng.hpp"
+#include "core/rotation.hpp"
 #include "core/stopwatch.hpp"
+#include "core/yaml_io.hpp"
 #include "eval/evaluate.hpp"
 #include "pipeline/progress.hpp"
+#include "pipeline/sensor_stage.hpp"
+#include "pipeline/tracks.hpp"
 #include "pipeline/vo_stage.hpp"
+#include "sim/sensors/clock.hpp"
 
 #ifndef DRIFTLAB_VERSION
 #define DRIFTLAB_VERSION "unknown"
@@ -21,14 +28,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct VoTrack {
-  std::string name;
-  std::unique_ptr<vo::StereoOdometry> vo;
-  Trajectory estimate;
-  std::vector<vo::VoResult> results;
-  double vo_ms = 0;
-};
-
 // The first frame with a true pose (all of them start there), and that pose.
 std::pair<std::size_t, SE3> first_anchored(const dataset::StereoDataset& d) {
   if (d.camera_gt.empty()) return {0, SE3()};
@@ -38,96 +37,196 @@ std::pair<std::size_t, SE3> first_anchored(const dataset::StereoDataset& d) {
       fmt::format("{}: no frame lies within the ground truth's time span", d.root.string()));
 }
 
-eval::FrameTable covariates(const VoTrack& t, const std::vector<dataset::DatasetFrame>& frames) {
+// Per-frame covariates of a track (its VO's): the features it counts (covariate f of the river
+// paper's Table 4) and their mean depth.
+eval::FrameTable covariates(const Track& src, const std::vector<dataset::DatasetFrame>& frames) {
   eval::FrameTable ft;
   ft.names = {"inliers", "mean_depth_m"};
   ft.columns.resize(2);
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (std::size_t k = 0; k < t.results.size(); ++k) {
-    const vo::VoResult& r = t.results[k];
+  for (std::size_t k = 0; k < src.results.size(); ++k) {
+    const vo::VoResult& r = src.results[k];
     ft.t_ns.push_back(frames[k].t_ns);
-    // Covariate f as the VO counts its features (river paper Table 4).
     ft.columns[0].push_back(r.valid ? r.feature_count() : nan);
     ft.columns[1].push_back(r.valid ? r.mean_inlier_depth_m : nan);
   }
   return ft;
 }
 
-}  // namespace
+// The filters' world: the dataset's world W turned so that its axis nearest to gravity is
+// down (z of the filters' NED). The IMU's mean specific force over the second around the first
+// frame, turned into W by the true attitude there, points up.
+struct LevelledWorld {
+  Mat3 R_N_W = Mat3::Identity();
+  std::string down_axis = "+z";
+  double tilt_deg = 0;  // between gravity and that axis
+  nlohmann::json to_json() const { return {{"down_axis", down_axis}, {"tilt_deg", tilt_deg}}; }
+};
 
-std::string DatasetRunSummary::brief() const {
-  std::string s = fmt::format("{} stereo frames in {:.2f} s", frames, total_s);
-  for (const auto& a : algorithms) s += "\n  " + a;
+LevelledWorld level_world(const std::vector<ImuSample>& imu, const SE3& T_W_S0, TimeNs t0) {
+  LevelledWorld w;
+  Vec3 f = Vec3::Zero();
+  for (const ImuSample& s : imu)
+    if (std::abs(static_cast<double>(s.t_ns - t0)) <= 0.5e9) f += s.accel_m_s2;
+  if (!(f.norm() > 0)) f = imu.front().accel_m_s2;  // no sample near the first frame
+  const Vec3 down_W = -(T_W_S0.rotation() * f).normalized();
+  int best = 0;  // the signed world axis nearest to down
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(down_W[i]) > std::abs(down_W[best])) best = i;
+  const double sign = down_W[best] >= 0 ? 1.0 : -1.0;
+  w.down_axis = std::string(sign > 0 ? "+" : "-") + "xyz"[best];
+  w.tilt_deg = rad2deg(std::acos(std::min(1.0, std::abs(down_W[best]))));
+  const Vec3 z = sign * Vec3::Unit(best);
+  const Vec3 x = Vec3::Unit(best == 0 ? 1 : 0);  // the first world axis across gravity
+  w.R_N_W.row(0) = x.transpose();
+  w.R_N_W.row(1) = z.cross(x).transpose();
+  w.R_N_W.row(2) = z.transpose();
+  return w;
+}
+
+// What the filters read from the dataset: its IMU from the last sample at or before the first
+// frame `t0` on (the filters start there, at the anchor), and its compass (no GPS: a dataset's
+// fixes carry no validity time).
+SensorData dataset_sensors(const dataset::StereoDataset& d, TimeNs t0) {
+  SensorData s;
+  auto from = std::upper_bound(d.imu.begin(), d.imu.end(), t0,
+                               [](TimeNs t, const ImuSample& x) { return t < x.t_ns; });
+  if (from != d.imu.begin()) --from;
+  s.imu.assign(from, d.imu.end());
+  for (const dataset::CompassReading& c : d.compass) {
+    sim::CompassSample m;
+    m.t_ns = c.t_ns;
+    m.heading_rad = c.heading_rad;
+    s.compass.push_back(m);
+  }
   return s;
 }
 
-DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario& settings,
-                                 const fs::path& out_dir, const DatasetRunOptions& options) {
-  const auto t0 = SteadyClock::now();
-  AtomicDirectory dir(out_dir, options.replace_existing);
-  write_file_atomic(dir.path() / "scenario.resolved.yaml", resolved_yaml(settings));
-  const RngStreams rng(settings.seed);
-  std::vector<VoTrack> tracks;
-  for (const std::string& a :
-       options.algorithms.empty() ? settings.pipeline.vo : options.algorithms)
-    tracks.push_back({a, make_vo(a, d.rig, settings.pipeline, rng), {}, {}, 0});
-  if (tracks.empty()) throw UserError("driftlab vo: no VO to run (--algo or pipeline.vo)");
-  const auto [first, T_W_C0] = first_anchored(d);
-  std::size_t end = d.frames.size();
-  if (options.max_frames > 0) end = std::min(end, first + options.max_frames);
+// The body is the dataset's IMU frame S (EuRoC's B): the camera's T_BS from the dataset, the
+// compass and GPS antenna from the settings' mounts, taken relative to the settings' IMU.
+FilterMounts dataset_mounts(const dataset::StereoDataset& d, const Scenario& settings) {
+  const FilterMounts from_settings = filter_mounts(settings);
+  const SE3 T_S_B = from_settings.T_B_I.inverse();
+  FilterMounts m;
+  m.T_B_C = d.T_S_C;
+  m.T_B_I = SE3();
+  m.R_B_M = T_S_B.rotation() * from_settings.R_B_M;
+  m.p_B_antenna_m = T_S_B * from_settings.p_B_antenna_m;
+  m.gps_sigma_horizontal_m = from_settings.gps_sigma_horizontal_m;
+  return m;
+}
 
-  AtomicFile frames_csv(dir.path() / "frames.csv");
+// The filters the dataset can feed: every one of `asked` (explicit: an error for one it
+// cannot; from the settings: skipped with a warning).
+std::vector<FusionAlgorithm> runnable_filters(const dataset::StereoDataset& d,
+                                              const std::vector<FusionAlgorithm>& asked,
+                                              bool explicit_request,
+                                              std::vector<std::string>* warnings) {
+  std::vector<FusionAlgorithm> out;
+  for (FusionAlgorithm f : asked) {
+    std::string missing;
+    const bool imu = f == FusionAlgorithm::kEskf;
+    const bool compass = f == FusionAlgorithm::kNedKf || f == FusionAlgorithm::kNedPf;
+    if ((imu || compass) && !d.has_extrinsics)
+      missing = "the camera's pose on the body (EuRoC's cam0 T_BS)";
+    else if (imu && d.imu.empty())
+      missing = "an IMU (EuRoC's mav0/imu0/data.csv)";
+    else if (compass && d.compass.empty())
+      missing = "a compass (mav0/compass0/data.csv, as driftlab's EuRoC exports have)";
+    if (missing.empty()) {
+      out.push_back(f);
+      continue;
+    }
+    const std::string why =
+        fmt::format("{} needs {}; {} has none", yaml::enum_name(f), missing, d.root.string());
+    if (explicit_request) throw UserError("driftlab vo: --fusion: " + why);
+    warnings->push_back(why + " (skipped)");
+  }
+  return out;
+}
+
+// The VO tracks, then one track per VO for each filter, all starting at the anchor. Filters
+// work in the levelled world N; `T_N_W` takes the anchor there.
+std::vector<Track> make_dataset_tracks(const dataset::StereoDataset& d, const Scenario& settings,
+                                       const std::vector<std::string>& algorithms,
+                                       const std::vector<FusionAlgorithm>& fusion,
+                                       const SensorData& sensors, const SE3& T_W_C0,
+                                       const SE3& T_N_W, std::size_t frames) {
+  const RngStreams rng(settings.seed);
+  std::vector<Track> tracks;
+  for (const std::string& a : algorithms) {
+    Track t;
+    t.name = a;
+    t.vo = make_vo(a, d.rig, settings.pipeline, rng);
+    t.results.resize(frames);
+    tracks.push_back(std::move(t));
+  }
+  if (tracks.empty()) throw UserError("driftlab vo: no VO to run (--algo or pipeline.vo)");
+  PipelineOptions options = settings.pipeline;
+  if (d.imu_noise) {  // the dataset's Kalibr model (imu0/sensor.yaml) over the settings'
+    options.eskf.gyro_noise_density_rad_s_sqrt_hz = d.imu_noise->gyroscope_noise_density;
+    options.eskf.gyro_random_walk_rad_s2_sqrt_hz = d.imu_noise->gyroscope_random_walk;
+    options.eskf.accel_noise_density_m_s2_sqrt_hz = d.imu_noise->accelerometer_noise_density;
+    options.eskf.accel_random_walk_m_s3_sqrt_hz = d.imu_noise->accelerometer_random_walk;
+  }
+  const FilterMounts mounts = dataset_mounts(d, settings);
+  const SE3 T_N_C0 = T_N_W * T_W_C0;
+  const SE3 T_N_B0 = T_N_C0 * mounts.T_B_C.inverse();
+  add_filter_tracks(
+      fusion, tracks.size(),
+      [&](FusionAlgorithm f) {
+        return std::make_unique<FilterTrack>(f, options, mounts, sensors, T_N_B0, T_N_C0, rng);
+      },
+      &tracks);
+  for (Track& t : tracks) t.estimate.push_back({0, T_W_C0});  // stamped in the frame loop
+  return tracks;
+}
+
+// Every frame through every track (the VOs, then the filters following them), a frames.csv
+// row each.
+void run_frames(const dataset::StereoDataset& d, const std::vector<dataset::DatasetFrame>& used,
+                const fs::path& dir, const DatasetRunOptions& options,
+                std::vector<Track>* tracks_io) {
+  std::vector<Track>& tracks = *tracks_io;
+  AtomicFile frames_csv(dir / "frames.csv");
   std::string header = "t_ns";
-  for (const auto& t : tracks) header += vo_csv_header(t.name);
+  for (const Track& t : tracks)
+    if (t.vo) header += vo_csv_header(t.name);
   frames_csv.write(header + "\n");
-  std::vector<dataset::DatasetFrame> used(d.frames.begin() + first, d.frames.begin() + end);
   Progress progress(options.progress, "vo", used.size(), options.progress_tty);
   for (std::size_t k = 0; k < used.size(); ++k) {
     progress.update(k);
     auto [left, right] = dataset::read_pair(d, used[k]);  // rectified when raw
-    vo::StereoFrame frame{used[k].t_ns, left, right};
+    const vo::StereoFrame frame{used[k].t_ns, left, right};
     std::string row = std::to_string(frame.t_ns);
-    for (auto& t : tracks) {
-      const vo::VoResult r = t.vo->process(frame);
-      row += vo_csv_cells(r);
-      t.vo_ms += r.times.total_ms;
-      t.results.push_back(r);
-      if (k == 0) {
-        t.estimate.push_back({frame.t_ns, T_W_C0});
-        continue;
-      }
-      const SE3 step = r.valid ? r.T_prev_curr : SE3();
-      t.estimate.push_back({frame.t_ns, t.estimate.back().T_W_C * step});  // river paper Eq. (3)
+    for (Track& t : tracks) {
+      const vo::VoResult r = t.vo ? t.vo->process(frame) : tracks[t.source].results[k];
+      if (t.vo) row += vo_csv_cells(r);
+      if (k == 0) t.estimate.front().t_ns = frame.t_ns;
+      advance_track(&t, k, k == 0, frame.t_ns, r);
     }
     frames_csv.write(row + "\n");
   }
   progress.update(used.size());
   progress.finish();
   frames_csv.commit();
+}
 
-  fs::create_directories(dir.path() / "estimates");
-  if (!d.camera_gt.empty()) write_tum(dir.path() / "groundtruth.tum", d.camera_gt);
-  nlohmann::json metrics;
-  metrics["version"] = DRIFTLAB_VERSION;
-  metrics["seed"] = settings.seed;
-  metrics["dataset"] = {{"root", d.root.string()},
-                        {"format", dataset::format_name(d.format)},
-                        {"frames_used", used.size()},
-                        {"first_frame", first},
-                        {"ground_truth", !d.camera_gt.empty()},
-                        {"fx_px", d.rig.camera.fx},
-                        {"baseline_m", d.rig.baseline_m},
-                        {"width_px", d.rig.camera.width},
-                        {"height_px", d.rig.camera.height}};
+// Every track against the dataset's ground truth: metrics.json's algorithms, tables.md and
+// sections.csv; one brief line per track.
+std::vector<std::string> evaluate_tracks(const dataset::StereoDataset& d, const Scenario& settings,
+                                         const std::vector<Track>& tracks,
+                                         const std::vector<dataset::DatasetFrame>& used,
+                                         const fs::path& dir, nlohmann::json* metrics,
+                                         std::vector<std::string>* warnings) {
+  std::vector<std::string> briefs;
   std::string tables, sections;
-  DatasetRunSummary summary;
-  summary.frames = used.size();
-  for (const auto& t : tracks) {
-    write_tum(dir.path() / "estimates" / (t.name + ".tum"), t.estimate);
-    metrics["timing"]["vo_ms_per_frame"][t.name] =
-        used.empty() ? 0.0 : t.vo_ms / static_cast<double>(used.size());
+  for (const Track& t : tracks) {
+    if (t.vo)
+      (*metrics)["timing"]["vo_ms_per_frame"][t.name] =
+          used.empty() ? 0.0 : t.vo_ms / static_cast<double>(used.size());
     if (d.camera_gt.empty()) {
-      summary.algorithms.push_back(t.name + ": no ground truth, estimate only");
+      briefs.push_back(t.name + ": no ground truth, estimate only");
       continue;
     }
     eval::EvaluationInput in;
@@ -137,19 +236,106 @@ DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario
     in.est_label = "estimates/" + t.name + ".tum";
     in.algorithm = t.name;
     in.options = settings.eval;
-    in.frames = covariates(t, used);
+    in.frames = covariates(t.vo ? t : tracks[t.source], used);
     const eval::Evaluation e = eval::evaluate(in);
-    metrics["algorithms"][t.name] = eval::to_json(e, settings.eval);
+    (*metrics)["algorithms"][t.name] = eval::to_json(e, settings.eval);
     tables += eval::tables_markdown(e, settings.eval) + "\n";
     const std::string csv = eval::sections_csv(e);
     sections += sections.empty() ? csv : csv.substr(csv.find('\n') + 1);
-    summary.algorithms.push_back(e.brief());
+    briefs.push_back(e.brief());
   }
-  if (!sections.empty()) write_file_atomic(dir.path() / "sections.csv", sections);
-  write_file_atomic(dir.path() / "tables.md",
+  if (!d.camera_gt.empty()) tables += compare_filters_with_raw_vo(tracks, metrics, warnings);
+  report_filter_counts(tracks, metrics, warnings);
+  if (!sections.empty()) write_file_atomic(dir / "sections.csv", sections);
+  write_file_atomic(dir / "tables.md",
                     fmt::format("# driftlab vo: {}\n\n{}", d.root.string(), tables));
+  return briefs;
+}
+
+nlohmann::json dataset_record(const dataset::StereoDataset& d, std::size_t used,
+                              std::size_t first) {
+  return {{"root", d.root.string()},
+          {"format", dataset::format_name(d.format)},
+          {"frames_used", used},
+          {"first_frame", first},
+          {"ground_truth", !d.camera_gt.empty()},
+          {"imu_samples", d.imu.size()},
+          {"compass_samples", d.compass.size()},
+          {"fx_px", d.rig.camera.fx},
+          {"baseline_m", d.rig.baseline_m},
+          {"width_px", d.rig.camera.width},
+          {"height_px", d.rig.camera.height}};
+}
+
+}  // namespace
+
+std::string DatasetRunSummary::brief() const {
+  std::string s = fmt::format("{} stereo frames in {:.2f} s", frames, total_s);
+  for (const auto& a : algorithms) s += "\n  " + a;
+  for (const auto& w : warnings) s += "\n  warning: " + w;
+  return s;
+}
+
+DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario& settings,
+                                 const fs::path& out_dir, const DatasetRunOptions& options) {
+  const auto t0 = SteadyClock::now();
+  AtomicDirectory dir(out_dir, options.replace_existing);
+  write_file_atomic(dir.path() / "scenario.resolved.yaml", resolved_yaml(settings));
+  nlohmann::json metrics;
+  DatasetRunSummary summary;
+  const auto [first, T_W_C0] = first_anchored(d);
+  std::size_t end = d.frames.size();
+  if (options.max_frames > 0) end = std::min(end, first + options.max_frames);
+  const std::vector<dataset::DatasetFrame> used(d.frames.begin() + first, d.frames.begin() + end);
+  const std::vector<FusionAlgorithm> fusion = runnable_filters(
+      d, settings.pipeline.fusion, options.fusion_on_command_line, &summary.warnings);
+  LevelledWorld world;
+  const bool gravity = std::any_of(fusion.begin(), fusion.end(), [](FusionAlgorithm f) {
+    return f != FusionAlgorithm::kCaSmoother;
+  });
+  if (gravity && !d.imu.empty() && !used.empty()) {
+    world = level_world(d.imu, T_W_C0 * d.T_S_C.inverse(), used.front().t_ns);
+    metrics["filters_world"] = world.to_json();
+    if (world.tilt_deg > 2.0)
+      summary.warnings.push_back(fmt::format(
+          "the dataset's world is tilted {:.1f} deg from gravity; the filters take {} as down",
+          world.tilt_deg, world.down_axis));
+  }
+  const bool levelled = world.R_N_W != Mat3::Identity();
+  const SensorData sensors = dataset_sensors(d, used.empty() ? 0 : used.front().t_ns);
+  std::vector<Track> tracks = make_dataset_tracks(
+      d, settings, options.algorithms.empty() ? settings.pipeline.vo : options.algorithms, fusion,
+      sensors, T_W_C0, levelled ? SE3(world.R_N_W, Vec3::Zero()) : SE3(), used.size());
+  run_frames(d, used, dir.path(), options, &tracks);
+  if (levelled)  // the filters' poses back into the dataset's world
+    for (Track& t : tracks)
+      if (t.filter)
+        for (std::size_t j = 1; j < t.estimate.size(); ++j)
+          t.estimate[j].T_W_C =
+              SE3(Mat3(world.R_N_W.transpose()), Vec3::Zero()) * t.estimate[j].T_W_C;
+  if (runs_backward_pass(settings.pipeline)) {
+    const std::vector<std::optional<TimeNs>> delivered = [&] {
+      std::vector<std::optional<TimeNs>> t;
+      for (const auto& f : used) t.push_back(f.t_ns);
+      return t;
+    }();
+    const std::size_t n_vo =
+        std::count_if(tracks.begin(), tracks.end(), [](const Track& t) { return t.vo != nullptr; });
+    for (std::size_t i = 0; i < n_vo; ++i)
+      tracks.push_back(rts_smoothed(tracks[i], i, delivered, settings.pipeline.ca_smoother));
+  }
+
+  write_estimates(tracks, dir.path());
+  if (!d.camera_gt.empty()) write_tum(dir.path() / "groundtruth.tum", d.camera_gt);
+  metrics["version"] = DRIFTLAB_VERSION;
+  metrics["seed"] = settings.seed;
+  metrics["dataset"] = dataset_record(d, used.size(), first);
+  summary.frames = used.size();
+  summary.algorithms =
+      evaluate_tracks(d, settings, tracks, used, dir.path(), &metrics, &summary.warnings);
   summary.total_s = seconds_since(t0);
   metrics["timing"]["total_s"] = summary.total_s;
+  metrics["warnings"] = summary.warnings;
   write_file_atomic(dir.path() / "metrics.json", metrics.dump(2) + "\n");
   dir.commit();
   return summary;

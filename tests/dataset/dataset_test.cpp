@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <fstream>
+#include <numbers>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -177,6 +178,11 @@ TEST(EurocExport, FollowsTheAslLayoutAndReadsBack) {
   ASSERT_EQ(d.imu.size(), 2u);
   EXPECT_EQ(d.imu[1].gyro_rad_s, imu[1].gyro_rad_s);
   EXPECT_EQ(d.imu[1].accel_m_s2, imu[1].accel_m_s2);
+  ASSERT_TRUE(d.imu_noise.has_value());  // imu0/sensor.yaml's Kalibr model, as written
+  EXPECT_EQ(d.imu_noise->gyroscope_noise_density, 1.7e-4);
+  EXPECT_EQ(d.imu_noise->accelerometer_random_walk, 3e-3);
+  EXPECT_TRUE(d.has_extrinsics);
+  EXPECT_TRUE(d.compass.empty());  // no compass0
   fs::remove_all(root);
 }
 
@@ -269,11 +275,49 @@ TEST(DatasetReaders, NameTheFileLineAndExpectation) {
             std::string::npos)
       << e;
   std::ofstream(cam1) << good_yaml;
+  // An IMU model without one of Kalibr's four noise parameters.
+  const std::vector<ImuSample> imu = {{1'000'000'000, Vec3(0, 0, 0), Vec3(0, 0, -9.8)}};
+  fs::create_directories(eu / "mav0" / "imu0");
+  write_euroc_imu(eu / "mav0" / "imu0" / "data.csv", imu);
+  std::ofstream(eu / "mav0" / "imu0" / "sensor.yaml") << "rate_hz: 200\n"
+                                                         "gyroscope_noise_density: 1e-4\n"
+                                                         "gyroscope_random_walk: -1\n";
+  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  EXPECT_NE(e.find("sensor.yaml:3: gyroscope_random_walk: got '-1', expected a number > 0"),
+            std::string::npos)
+      << e;
+  fs::remove_all(eu / "mav0" / "imu0");
   std::ofstream(eu / "mav0" / "cam0" / "data.csv") << "#timestamp [ns],filename\n12x,a.png\n";
   e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
   EXPECT_NE(e.find("data.csv:2: timestamp: got '12x'"), std::string::npos) << e;
   fs::remove_all(root);
   fs::remove_all(eu);
+}
+
+TEST(CompassCsv, ReadsHeadingsInDegreesAndNamesTheLineOfABadOne) {
+  const fs::path dir = test::fresh_temp_dir("compass_csv");
+  const fs::path csv = dir / "compass.csv";
+  std::ofstream(csv) << "#timestamp [ns],heading [deg],m_S_x [nT],m_S_y [nT],m_S_z [nT]\n"
+                        "100,90,1,2,3\n200,270,1,2,3\n";
+  const auto r = read_compass_csv(csv);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[0].t_ns, 100);
+  EXPECT_NEAR(r[0].heading_rad, std::numbers::pi / 2, 1e-15);
+  EXPECT_NEAR(r[1].heading_rad, -std::numbers::pi / 2, 1e-15);  // wrapped to (-pi, pi]
+  std::ofstream(csv) << "100,90,1,2,3\n200,360,1,2,3\n";
+  std::string e = error_of([&] { read_compass_csv(csv); });
+  EXPECT_NE(e.find(csv.string() + ":2: heading: got 360, expected degrees in [0, 360)"),
+            std::string::npos)
+      << e;
+  std::ofstream(csv) << "100,90,1,2,3\n100,91,1,2,3\n";
+  e = error_of([&] { read_compass_csv(csv); });
+  EXPECT_NE(e.find(":2: timestamp: got 100, expected more than the line before's 100"),
+            std::string::npos)
+      << e;
+  std::ofstream(csv) << "100,90\n";
+  e = error_of([&] { read_compass_csv(csv); });
+  EXPECT_NE(e.find(":1: got 2 columns, expected 5"), std::string::npos) << e;
+  fs::remove_all(dir);
 }
 
 TEST(PoseAt, InterpolatesBetweenNeighboursAndNothingOutside) {

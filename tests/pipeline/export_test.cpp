@@ -204,6 +204,111 @@ TEST(Export, EurocGroundTruthCarriesTheSimulatedImusBiases) {
   fs::remove_all(root);
 }
 
+// A scenario with every filter and no GPS (a dataset's GPS fixes are not read: they carry no
+// validity time) and no dropped frames (the run's ESKF starts at the first frame, dropped or
+// not; the dataset's at its first image).
+Scenario filtered_crossing() {
+  Scenario s = load_scenario(test::source_dir() / "scenarios/river_crossing.yaml");
+  s.pipeline.max_frames = 30;
+  s.pipeline.vo = {"sparse"};
+  s.pipeline.fusion = {FusionAlgorithm::kCaSmoother, FusionAlgorithm::kEskf,
+                       FusionAlgorithm::kNedKf, FusionAlgorithm::kNedPf};
+  s.pipeline.ca_smoother.rts_backward_pass = true;  // NAME_ca_rts too
+  s.sensors.gps.enabled = false;
+  return s;
+}
+
+const char* const kFilteredEstimates[] = {"sparse",      "sparse_ca",     "sparse_ca_rts",
+                                          "sparse_eskf", "sparse_ned_kf", "sparse_ned_pf"};
+
+TEST(ExportFilters, EveryFilterOnTheEurocExportFollowsTheRunsFilter) {
+  // The export carries the IMU with its noise model, the compass and the camera's mount, so
+  // each filter on the dataset gives the run's estimate. Compared relative to the first pose,
+  // as for the VOs: the dataset's anchor is its 200 Hz ground truth interpolated at the first
+  // frame, which moves the whole estimate by a few micrometres.
+  const fs::path root = test::unused_temp_path("export_filters");
+  const Scenario sc = filtered_crossing();
+  run_scenario(sc, root / "run", {});
+  ExportOptions o;
+  o.format = dataset::DatasetFormat::kEuroc;
+  export_dataset(sc, root / "export", o);
+  const dataset::StereoDataset data = dataset::read_dataset(root / "export", o.format);
+  ASSERT_TRUE(data.imu_noise.has_value());
+  EXPECT_EQ(data.imu_noise->gyroscope_noise_density,
+            sc.sensors.imu.gyro_noise_density_rad_s_sqrt_hz);
+  EXPECT_FALSE(data.compass.empty());
+  const auto summary =
+      run_on_dataset(data, load_scenario(root / "export/scenario.resolved.yaml"), root / "vo", {});
+  for (const char* name : kFilteredEstimates) {
+    const Trajectory from_run = read_tum(root / "run/estimates" / (std::string(name) + ".tum"));
+    const Trajectory from_vo = read_tum(root / "vo/estimates" / (std::string(name) + ".tum"));
+    EXPECT_LT(largest_relative_difference(from_run, from_vo), 1e-9) << name;
+  }
+  const auto run = nlohmann::json::parse(slurp(root / "run/metrics.json"));
+  const auto vo = nlohmann::json::parse(slurp(root / "vo/metrics.json"));
+  for (const char* name : {"sparse_eskf", "sparse_ned_kf", "sparse_ned_pf"})  // same inputs
+    EXPECT_EQ(run["algorithms"][name]["filter"], vo["algorithms"][name]["filter"]) << name;
+  EXPECT_EQ(vo["filters_world"]["down_axis"], "+z");  // the scenario's world is NED
+  EXPECT_LT(vo["filters_world"]["tilt_deg"].get<double>(), 1.0);
+  EXPECT_GT(vo["algorithms"]["sparse_eskf"]["filter"]["imu_samples"].get<int>(), 100);
+  fs::remove_all(root);
+}
+
+TEST(ExportFilters, ADatasetWhoseWorldIsZUpGivesTheSameEstimatesInItsWorld) {
+  // EuRoC's own ground truth is in a z-up world. The same export with its ground truth turned
+  // half a turn about north (z up, y west): every estimate, filters included, is the first
+  // one's turned the same way, because the filters level the world on gravity.
+  const fs::path root = test::unused_temp_path("export_zup");
+  Scenario sc = filtered_crossing();
+  sc.pipeline.max_frames = 15;
+  ExportOptions o;
+  o.format = dataset::DatasetFormat::kEuroc;
+  export_dataset(sc, root / "export", o);
+  const Scenario settings = load_scenario(root / "export/scenario.resolved.yaml");
+  run_on_dataset(dataset::read_dataset(root / "export", o.format), settings, root / "ned", {});
+  const fs::path gt = root / "export/mav0/state_groundtruth_estimate0/data.csv";
+  const SE3 T_U_N(Mat3(Vec3(1, -1, -1).asDiagonal()), Vec3::Zero());
+  Trajectory turned = read_euroc_groundtruth(gt);
+  for (StampedPose& p : turned) p.T_W_C = T_U_N * p.T_W_C;
+  write_euroc_groundtruth(gt, turned);
+  run_on_dataset(dataset::read_dataset(root / "export", o.format), settings, root / "zup", {});
+  for (const char* name : kFilteredEstimates) {
+    const Trajectory ned = read_tum(root / "ned/estimates" / (std::string(name) + ".tum"));
+    Trajectory zup = read_tum(root / "zup/estimates" / (std::string(name) + ".tum"));
+    ASSERT_EQ(ned.size(), zup.size()) << name;
+    double worst = 0;
+    for (std::size_t i = 0; i < ned.size(); ++i)
+      worst = std::max(worst, ((T_U_N * ned[i].T_W_C).inverse() * zup[i].T_W_C).log().norm());
+    EXPECT_LT(worst, 1e-12) << name;
+  }
+  const auto metrics = nlohmann::json::parse(slurp(root / "zup/metrics.json"));
+  EXPECT_EQ(metrics["filters_world"]["down_axis"], "-z");
+  fs::remove_all(root);
+}
+
+TEST(ExportFilters, AFilterTheDatasetCannotFeedIsAnErrorWhenAskedForAndSkippedOtherwise) {
+  const fs::path root = test::unused_temp_path("export_nofeed");
+  const std::string scenario = (test::source_dir() / "scenarios/river_crossing.yaml").string();
+  auto r = test::run_cli({"export", scenario, "--frames", "4", "--out", (root / "kitti").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_cli({"vo", (root / "kitti").string(), "--fusion", "ca_smoother,eskf", "--out",
+                     (root / "vo").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--fusion: eskf needs the camera's pose on the body"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(root / "vo"));
+  // From the settings (the export's own scenario asks for the ESKF): skipped, and said so.
+  r = test::run_cli({"vo", (root / "kitti").string(), "--set",
+                     "pipeline.fusion=[ca_smoother, eskf]", "--out", (root / "vo").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(root / "vo/estimates/sparse_ca.tum"));
+  EXPECT_FALSE(fs::exists(root / "vo/estimates/sparse_eskf.tum"));
+  const auto metrics = nlohmann::json::parse(slurp(root / "vo/metrics.json"));
+  ASSERT_EQ(metrics["warnings"].size(), 1u);
+  EXPECT_NE(metrics["warnings"][0].get<std::string>().find("eskf needs"), std::string::npos);
+  fs::remove_all(root);
+}
+
 TEST(ExportCli, WritesEachFormatAndVoReadsIt) {
   const fs::path root = test::unused_temp_path("export_cli");
   const std::string scenario = (test::source_dir() / "scenarios/river_crossing.yaml").string();
