@@ -28,6 +28,7 @@
 #include "pipeline/tracks.hpp"
 #include "pipeline/vo_stage.hpp"
 #include "report/run_report.hpp"
+#include "scenes/assets.hpp"
 #include "scenes/build_scene.hpp"
 #include "sim/render/renderer.hpp"
 #include "sim/sensors/clock.hpp"
@@ -452,6 +453,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   (*metrics)["camera"] = camera_metrics(sc, camera_gt.size(), dropped);
   (*metrics)["warnings"] = warnings;
   (*metrics)["render"] = {{"context", source.info().context},
+                          {"assets", scenes::shipped_asset_dir()},
                           {"triangles", source.info().triangles}};
   summary->render_pairs_per_s = (*metrics)["timing"]["render_pairs_per_s"];
 }

@@ -1,6 +1,7 @@
 #include "scenes/assets.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 
@@ -11,16 +12,37 @@
 
 #include "core/error.hpp"
 
-// The build points this at the source tree's scenes/assets; without it, the
-// path is relative to the working directory (tests and the CLI run from the
-// repository root).
+// The build points these at the source tree's scenes/assets and at the install prefix's
+// share/driftlab/assets; without them, the path is relative to the working directory.
 #ifndef DRIFTLAB_SCENES_ASSET_DIR
 #define DRIFTLAB_SCENES_ASSET_DIR "scenes/assets"
+#endif
+#ifndef DRIFTLAB_INSTALLED_ASSET_DIR
+#define DRIFTLAB_INSTALLED_ASSET_DIR ""
 #endif
 
 namespace driftlab::scenes {
 
-std::string shipped_asset_dir() { return DRIFTLAB_SCENES_ASSET_DIR; }
+namespace {
+
+bool is_dir(const std::filesystem::path& p) {
+  std::error_code ec;
+  return !p.empty() && std::filesystem::is_directory(p, ec);
+}
+
+}  // namespace
+
+std::string shipped_asset_dir() {
+  if (const char* env = std::getenv("DRIFTLAB_ASSET_DIR"); env && *env) return env;
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  // An installed program: PREFIX/bin/driftlab next to PREFIX/share/driftlab/assets.
+  if (!ec && is_dir(exe.parent_path().parent_path() / "share/driftlab/assets"))
+    return (exe.parent_path().parent_path() / "share/driftlab/assets").string();
+  if (is_dir(DRIFTLAB_SCENES_ASSET_DIR)) return DRIFTLAB_SCENES_ASSET_DIR;
+  if (is_dir(DRIFTLAB_INSTALLED_ASSET_DIR)) return DRIFTLAB_INSTALLED_ASSET_DIR;
+  return DRIFTLAB_SCENES_ASSET_DIR;  // missing: the error names it
+}
 
 std::string shipped_asset(const std::string& file_name) {
   return (std::filesystem::path(shipped_asset_dir()) / file_name).string();
@@ -29,8 +51,13 @@ std::string shipped_asset(const std::string& file_name) {
 sim::Mesh load_mesh_asset(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
-    throw UserError(
-        fmt::format("mesh asset '{}': no such file (expected an OBJ, PLY or glTF file)", path));
+    throw UserError(fmt::format(
+        "mesh asset '{}': no such file (expected an OBJ, PLY or glTF file){}", path,
+        path.starts_with(shipped_asset_dir())
+            ? "; driftlab's own assets are looked for in $DRIFTLAB_ASSET_DIR, "
+              "PREFIX/share/driftlab/assets beside PREFIX/bin/driftlab, and the source tree's "
+              "scenes/assets"
+            : ""));
 
   Assimp::Importer importer;
   // Hard edges (a bollard's rim, a box corner) keep separate normals.

@@ -17,8 +17,11 @@ namespace driftlab::scenes {
 /// missing, unreadable or corrupt, or holds no triangles.
 sim::Mesh load_mesh_asset(const std::string& path);
 
-/// Folder of the assets shipped with driftlab (scenes/assets in the source
-/// tree; the build sets it, else the path relative to the working directory).
+/// Folder of the assets shipped with driftlab, the first that exists of: the environment's
+/// DRIFTLAB_ASSET_DIR (taken as given), PREFIX/share/driftlab/assets beside the running
+/// program's PREFIX/bin (an installed driftlab), the source tree's scenes/assets, and the
+/// configured install prefix's share/driftlab/assets (a user's program linked against the
+/// installed libraries).
 std::string shipped_asset_dir();
 
 /// Path of a shipped asset, e.g. shipped_asset("bollard.obj").

@@ -53,6 +53,23 @@ TEST(InstalledPackage, CustomVoProjectBuildsRegistersAndRuns) {
   EXPECT_GT(travelled, 0.5);
   EXPECT_LT(miss, 0.5 * travelled) << "travelled " << travelled;
 
+  // The installed driftlab reads the scene's meshes from the prefix (share/driftlab/assets),
+  // not from the source tree; DRIFTLAB_ASSET_DIR overrides both.
+  EXPECT_TRUE(fs::exists(prefix / "share/driftlab/assets/bollard.obj"));
+  const std::string installed = shell_quote((prefix / "bin/driftlab").string()) + " run " +
+                                shell_quote(scenario) +
+                                " --set pipeline.max_frames=2 --set 'pipeline.fusion=[]' --out ";
+  r = run_shell("env -u DRIFTLAB_ASSET_DIR " + installed + shell_quote((root / "run2").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto m2 = nlohmann::json::parse(test::slurp(root / "run2/metrics.json"));
+  EXPECT_EQ(fs::path(m2["render"]["assets"].get<std::string>()), prefix / "share/driftlab/assets");
+  r = run_shell("DRIFTLAB_ASSET_DIR=" + shell_quote((root / "nowhere").string()) + " " + installed +
+                shell_quote((root / "run3").string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("nowhere/bollard.obj': no such file"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("$DRIFTLAB_ASSET_DIR"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(root / "run3"));
+
   // driftlab itself has no lk_pnp: the reader names the choices.
   const auto plain =
       test::run_cli({"scenario", "check", scenario, "-q", "--set", "pipeline.vo=[lk_pnp]"});
