@@ -304,6 +304,41 @@ void Reader::exactly_one_of(std::initializer_list<const char*> keys) {
   }
 }
 
+void Reader::read_named(const YAML::Node& node, const std::string& key_path, NamedOptions& value) {
+  if (node.IsNull()) return;  // "plugins:" with nothing under it
+  if (!node.IsMap()) {
+    fail(node, key_path, describe_node(node), "a mapping of names to their options");
+    return;
+  }
+  for (const auto& kv : node) {
+    const YAML::Node k = kv.first;
+    const YAML::Node options = kv.second;
+    if (!k.IsScalar() || k.Scalar().empty()) {
+      fail(k, key_path, describe_node(k), "a plain, non-empty name");
+      continue;
+    }
+    NamedOptions::Holder* holder = value.find_or_make(k.Scalar());
+    if (!holder) {
+      std::string names;
+      for (const auto& n : value.known_names()) names += (names.empty() ? "" : ", ") + n;
+      fail(k, key_path, "'" + k.Scalar() + "'",
+           names.empty() ? "the name of a VO registered with options (this program has none)"
+                         : "one of: " + names);
+      continue;
+    }
+    if (options.IsNull()) continue;  // "my_vo:" alone: its defaults
+    if (!options.IsMap()) {
+      fail(options, key_path + "." + k.Scalar(), describe_node(options),
+           "a mapping of keys to values");
+      continue;
+    }
+    Reader sub(options, source_, key_path + "." + k.Scalar(), errors_);
+    sub.set_check_rules(check_rules_);
+    holder->accept(sub);
+    sub.finish();
+  }
+}
+
 void Reader::finish() {
   for (std::size_t i = 0; i < entries_.size(); ++i) {
     const YAML::Node& key = entries_[i].first;
@@ -447,6 +482,48 @@ void Writer::line(const std::string& text, const char* doc) {
   out_ += '\n';
 }
 
+void Writer::write_named(const char* key, const NamedOptions& value, const char* doc) {
+  if (value.empty()) {
+    line(std::string(key) + ": {}", doc);
+    return;
+  }
+  line(std::string(key) + ":", doc);
+  for (const auto& [name, holder] : value.entries()) {
+    Writer sub(indent_ + 2, comments_);
+    sub.line(name + ":", nullptr);
+    Writer fields(indent_ + 4, comments_);
+    holder->accept(fields);
+    out_ += sub.str() + fields.str();
+  }
+}
+
+// ---------------------------------------------------------------------------
+// NamedOptions
+
+NamedOptions::NamedOptions(const NamedOptions& o) : maker_(o.maker_), names_(o.names_) {
+  for (const auto& [name, holder] : o.entries_) entries_.emplace_back(name, holder->clone());
+}
+
+NamedOptions& NamedOptions::operator=(const NamedOptions& o) {
+  if (this != &o) *this = NamedOptions(o);
+  return *this;
+}
+
+const NamedOptions::Holder* NamedOptions::find(const std::string& name) const {
+  for (const auto& [n, holder] : entries_)
+    if (n == name) return holder.get();
+  return nullptr;
+}
+
+NamedOptions::Holder* NamedOptions::find_or_make(const std::string& name) {
+  for (auto& [n, holder] : entries_)
+    if (n == name) return holder.get();
+  std::unique_ptr<Holder> made = make(name);
+  if (!made) return nullptr;
+  entries_.emplace_back(name, std::move(made));
+  return entries_.back().second.get();
+}
+
 // ---------------------------------------------------------------------------
 // Validator
 
@@ -486,6 +563,22 @@ void SchemaBuilder::require(bool, const char* key, std::string_view expected) {
       row.constraint += (row.constraint.empty() ? "" : "; ") + std::string(expected);
       return;
     }
+  }
+}
+
+void SchemaBuilder::add_named(const std::string& key_path, const NamedOptions& value,
+                              const char* doc) {
+  const std::vector<std::string> names = value.known_names();
+  std::string choices;
+  for (const auto& n : names) choices += (choices.empty() ? "" : ", ") + n;
+  rows_->push_back({key_path, "mapping of names to their options", "{}",
+                    choices.empty() ? "" : "names: " + choices, doc});
+  for (const auto& name : names) {  // each registered name's options, at their defaults
+    const std::unique_ptr<NamedOptions::Holder> holder = value.make(name);
+    if (!holder) continue;
+    rows_->push_back({key_path + "." + name, "mapping", "", "", "Options of " + name});
+    SchemaBuilder sub(key_path + "." + name, rows_);
+    holder->accept(sub);
   }
 }
 

@@ -41,6 +41,7 @@
 #include <functional>
 #include <initializer_list>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -168,6 +169,64 @@ template <class T>
 struct is_entries : std::false_type {};
 template <class T, class Alloc>
 struct is_entries<std::vector<Entry<T>, Alloc>> : std::true_type {};
+
+class Reader;
+class Writer;
+class Validator;
+class SchemaBuilder;
+
+/// A mapping of names to options structs whose type each name decides at run time: the
+/// options of plug-ins registered by name (pipeline.plugins.my_vo.KEY). Read, written,
+/// validated and documented like nested structs; reading a name again reads onto what it
+/// holds, so `--set a.NAME.KEY=V` changes one key and keeps the rest.
+class NamedOptions {
+ public:
+  /// One name's options struct (make_options<T>() makes one).
+  class Holder {
+   public:
+    virtual ~Holder() = default;
+    virtual std::unique_ptr<Holder> clone() const = 0;
+    virtual void accept(Reader& archive) = 0;
+    virtual void accept(Writer& archive) const = 0;
+    virtual void accept(Validator& archive) const = 0;
+    virtual void accept(SchemaBuilder& archive) const = 0;
+  };
+  /// The options of `name` at their defaults, or null for a name without options.
+  using Maker = std::function<std::unique_ptr<Holder>(const std::string& name)>;
+  /// Every name with options (for messages and the reference).
+  using Names = std::function<std::vector<std::string>()>;
+
+  NamedOptions() = default;
+  NamedOptions(Maker maker, Names names) : maker_(std::move(maker)), names_(std::move(names)) {}
+  NamedOptions(const NamedOptions& o);
+  NamedOptions& operator=(const NamedOptions& o);
+  NamedOptions(NamedOptions&&) noexcept = default;
+  NamedOptions& operator=(NamedOptions&&) noexcept = default;
+
+  bool empty() const { return entries_.empty(); }
+  /// The options given for `name`, or null when none were.
+  const Holder* find(const std::string& name) const;
+  /// The options of `name`, made at their defaults when not there yet; null for a name that
+  /// has no options.
+  Holder* find_or_make(const std::string& name);
+  /// Every name with options (not only those given).
+  std::vector<std::string> known_names() const {
+    return names_ ? names_() : std::vector<std::string>{};
+  }
+  /// A fresh holder of `name`'s defaults, or null.
+  std::unique_ptr<Holder> make(const std::string& name) const {
+    return maker_ ? maker_(name) : nullptr;
+  }
+  /// The names given, in the order first read, with their options.
+  const std::vector<std::pair<std::string, std::unique_ptr<Holder>>>& entries() const {
+    return entries_;
+  }
+
+ private:
+  Maker maker_;
+  Names names_;
+  std::vector<std::pair<std::string, std::unique_ptr<Holder>>> entries_;
+};
 
 struct ProbeArchive;  // used only to detect visitable structs
 
@@ -319,6 +378,7 @@ class Reader {
   template <class T>
   void read_entries(const YAML::Node& node, const std::string& key_path, Entries<T>& value,
                     const Check& check);
+  void read_named(const YAML::Node& node, const std::string& key_path, NamedOptions& value);
 
   bool read_scalar_text(const YAML::Node& node, const std::string& key_path, const char* expected,
                         std::string* text);
@@ -363,6 +423,8 @@ void Reader::read_value(const YAML::Node& node, const std::string& key_path, T& 
     value.where = where(node);
   } else if constexpr (is_entries<T>::value) {
     read_entries(node, key_path, value, check);
+  } else if constexpr (std::is_same_v<T, NamedOptions>) {
+    read_named(node, key_path, value);
   } else if constexpr (std::is_same_v<T, bool>) {
     std::string text;
     if (!read_scalar_text(node, key_path, "true or false", &text)) return;
@@ -558,6 +620,7 @@ class Writer : public IgnoresRules {
   static std::string scalar(const T& value);
   template <class T>
   void write_field(const char* key, const T& value, const char* doc);
+  void write_named(const char* key, const NamedOptions& value, const char* doc);
   void line(const std::string& text, const char* doc);
 
   int indent_;
@@ -612,6 +675,8 @@ void Writer::write_field(const char* key, const T& value, const char* doc) {
     Writer sub(indent_ + 2, comments_);
     for (const auto& e : value) sub.write_field(e.key.c_str(), e.value, nullptr);
     out_ += sub.str();
+  } else if constexpr (std::is_same_v<T, NamedOptions>) {
+    write_named(key, value, doc);
   } else if constexpr (Visitable<T>) {
     line(std::string(key) + ":", doc);
     Writer sub(indent_ + 2, comments_);
@@ -673,6 +738,11 @@ void Validator::check_value(const std::string& key_path, const T& value, const C
     if (value) check_value(key_path, *value, check);
   } else if constexpr (is_entries<T>::value) {
     for (const auto& e : value) check_value(key_path + "." + e.key, e.value, check);
+  } else if constexpr (std::is_same_v<T, NamedOptions>) {
+    for (const auto& [name, holder] : value.entries()) {
+      Validator sub(key_path + "." + name, errors_);
+      holder->accept(sub);
+    }
   } else if constexpr (std::is_floating_point_v<T> ||
                        (std::is_integral_v<T> && !std::is_same_v<T, bool>)) {
     check_double(key_path, static_cast<double>(value), check);
@@ -745,6 +815,7 @@ class SchemaBuilder : public IgnoresRules {
   static std::string type_name();
   template <class T>
   void add(const char* key, const T& value, const char* doc, const Check& check);
+  void add_named(const std::string& key_path, const NamedOptions& value, const char* doc);
 
   std::string prefix_;
   std::vector<SchemaRow>* rows_;
@@ -784,7 +855,9 @@ std::string SchemaBuilder::type_name() {
 template <class T>
 void SchemaBuilder::add(const char* key, const T& value, const char* doc, const Check& check) {
   const std::string key_path = prefix_.empty() ? key : prefix_ + "." + key;
-  if constexpr (OptionalOfVisitable<T>) {
+  if constexpr (std::is_same_v<T, NamedOptions>) {
+    add_named(key_path, value, doc);
+  } else if constexpr (OptionalOfVisitable<T>) {
     rows_->push_back({key_path, "mapping or null", "null", check.describe(), doc});
     typename T::value_type inner{};
     SchemaBuilder sub(key_path, rows_);
@@ -821,5 +894,38 @@ std::vector<SchemaRow> schema_of(const T& value) {
 
 /// Markdown table of schema rows.
 std::string schema_markdown(const std::vector<SchemaRow>& rows);
+
+// ---------------------------------------------------------------------------
+// NamedOptions' holder of one options struct.
+
+template <Visitable T>
+class TypedOptions final : public NamedOptions::Holder {
+ public:
+  explicit TypedOptions(T value) : value_(std::move(value)) {}
+  std::unique_ptr<NamedOptions::Holder> clone() const override {
+    return std::make_unique<TypedOptions>(value_);
+  }
+  void accept(Reader& a) override { value_.visit(a); }
+  void accept(Writer& a) const override { const_cast<T&>(value_).visit(a); }
+  void accept(Validator& a) const override { const_cast<T&>(value_).visit(a); }
+  void accept(SchemaBuilder& a) const override { const_cast<T&>(value_).visit(a); }
+  const T& value() const { return value_; }
+
+ private:
+  T value_;
+};
+
+/// A holder of `value` (by default T's defaults), for a NamedOptions::Maker.
+template <Visitable T>
+std::unique_ptr<NamedOptions::Holder> make_options(T value = T{}) {
+  return std::make_unique<TypedOptions<T>>(std::move(value));
+}
+
+/// The struct `holder` holds, or null when it holds another type (or is null).
+template <Visitable T>
+const T* options_of(const NamedOptions::Holder* holder) {
+  const auto* typed = dynamic_cast<const TypedOptions<T>*>(holder);
+  return typed ? &typed->value() : nullptr;
+}
 
 }  // namespace driftlab::yaml

@@ -94,6 +94,8 @@ struct PipelineOptions {
   fusion::NedFilterOptions ned_kf;
   fusion::NedParticleFilterOptions ned_pf;
   fusion::EskfOptions eskf;
+  /// Options of the VOs the program registered with options (vo/registry.hpp).
+  yaml::NamedOptions plugins = vo::plugin_options();
 
   template <class A>
   void visit(A& a) {
@@ -123,6 +125,9 @@ struct PipelineOptions {
     a("ned_kf", ned_kf, "Options of the NED Kalman filter (basin paper Section 3.1.1)");
     a("ned_pf", ned_pf, "Options of the NED particle filter (basin paper Section 3.1.2)");
     a("eskf", eskf, "Options of the error-state VO + IMU + GPS + compass filter");
+    a("plugins", plugins,
+      "Options of the VOs a program of your own registered with options, by name: "
+      "plugins.my_vo.KEY (vo/registry.hpp; README: Your VO in-process)");
   }
 };
 

@@ -19,7 +19,7 @@ std::unique_ptr<vo::StereoOdometry> make_vo(const std::string& name, const Stere
     return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse_kf, stream);
   if (name == "pnp") return std::make_unique<vo::PnpStereoOdometry>(rig, p.pnp, stream);
   if (name == "dense") return std::make_unique<vo::DenseStereoOdometry>(rig, p.dense, stream);
-  if (auto v = vo::make_registered_vo(name, rig, stream)) return v;
+  if (auto v = vo::make_registered_vo(name, rig, stream, p.plugins)) return v;
   std::string names;
   for (const auto& n : vo::available_vo_names()) names += (names.empty() ? "" : ", ") + n;
   throw UserError(fmt::format("pipeline.vo: got '{}', expected one of: {}", name, names));

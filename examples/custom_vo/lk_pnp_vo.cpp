@@ -7,8 +7,8 @@
 using driftlab::vo::StereoFrame;
 using driftlab::vo::VoResult;
 
-LkPnpVo::LkPnpVo(const driftlab::StereoRig& rig, driftlab::Rng rng)
-    : rig_(rig), initial_rng_(rng), rng_(rng) {}
+LkPnpVo::LkPnpVo(const driftlab::StereoRig& rig, driftlab::Rng rng, const LkPnpOptions& options)
+    : rig_(rig), options_(options), initial_rng_(rng), rng_(rng) {}
 
 void LkPnpVo::reset() {
   prev_left_.release();
@@ -27,7 +27,8 @@ VoResult LkPnpVo::process(const StereoFrame& frame) {
   }
   // Corners of the previous left image, followed into the previous right and the current left.
   std::vector<cv::Point2f> corners, in_right, in_current;
-  cv::goodFeaturesToTrack(prev_left, corners, 600, 0.01, 8);
+  cv::goodFeaturesToTrack(prev_left, corners, options_.max_corners, 0.01,
+                          options_.min_corner_distance_px);
   if (corners.size() < 10) {
     r.reason = "too few corners";
     return r;
@@ -50,7 +51,7 @@ VoResult LkPnpVo::process(const StereoFrame& frame) {
     pixels.push_back(in_current[i]);
   }
   r.matches = static_cast<int>(points.size());
-  if (points.size() < 10) {
+  if (static_cast<int>(points.size()) < options_.min_inliers) {
     r.reason = "too few stereo matches";
     return r;
   }
@@ -60,9 +61,9 @@ VoResult LkPnpVo::process(const StereoFrame& frame) {
   const cv::Matx33d K(c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
   cv::Vec3d rvec, tvec;
   std::vector<int> inliers;
-  if (!cv::solvePnPRansac(points, pixels, K, cv::noArray(), rvec, tvec, false, 200, 1.0, 0.999,
-                          inliers) ||
-      inliers.size() < 10) {
+  if (!cv::solvePnPRansac(points, pixels, K, cv::noArray(), rvec, tvec, false, 200,
+                          static_cast<float>(options_.ransac_threshold_px), 0.999, inliers) ||
+      static_cast<int>(inliers.size()) < options_.min_inliers) {
     r.reason = "PnP failed";
     return r;
   }

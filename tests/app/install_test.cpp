@@ -3,8 +3,13 @@
 // and run by its own driftlab command line beside the built-in ones.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "core/trajectory_io.hpp"
 #include "tests/support/test_support.hpp"
@@ -53,6 +58,79 @@ TEST(InstalledPackage, CustomVoProjectBuildsRegistersAndRuns) {
   EXPECT_GT(travelled, 0.5);
   EXPECT_LT(miss, 0.5 * travelled) << "travelled " << travelled;
 
+  // Its options (pipeline.plugins.lk_pnp) through driftlab's strict reader: set, written back,
+  // documented, checked, and in effect (no frame has more inliers than corners detected).
+  r = run_shell(shell_quote((build / "my-driftlab").string()) + " run " + shell_quote(scenario) +
+                " --set pipeline.max_frames=12 --set 'pipeline.vo=[lk_pnp]' --set "
+                "'pipeline.fusion=[]' --set pipeline.plugins.lk_pnp.max_corners=40 --out " +
+                shell_quote((root / "few").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(test::slurp(root / "few/scenario.resolved.yaml")
+                .find("    lk_pnp:\n      max_corners: 40  #"),
+            std::string::npos);
+  {
+    std::istringstream frames(test::slurp(root / "few/frames.csv"));
+    std::string line;
+    std::getline(frames, line);
+    int valid = 0;
+    while (std::getline(frames, line)) {  // t_ns,yaw,pitch,roll,render_ms,exposure_ms,valid,inliers
+      std::vector<std::string> cells;
+      std::stringstream ss(line);
+      for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+      ASSERT_GE(cells.size(), 8u);
+      valid += cells[6] == "1";
+      EXPECT_LE(std::stoi(cells[7]), 40) << line;
+    }
+    EXPECT_GT(valid, 5);
+  }
+  const std::string my = shell_quote((build / "my-driftlab").string());
+  r = run_shell(my + " scenario schema");
+  EXPECT_NE(
+      r.output.find("`pipeline.plugins.lk_pnp.max_corners` | integer | `600` | in [10, 10000]"),
+      std::string::npos)
+      << r.output.substr(0, 2000);
+  r = run_shell(my + " scenario check -q " + shell_quote(scenario) +
+                " --set pipeline.plugins.lk_pnp.max_corners=5");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("pipeline.plugins.lk_pnp.max_corners: got 5, expected a value in [10, "
+                          "10000]"),
+            std::string::npos)
+      << r.output;
+  r = run_shell(my + " scenario check -q " + shell_quote(scenario) +
+                " --set pipeline.plugins.lk_pnp.min_inliers=700");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("pipeline.plugins.lk_pnp.min_inliers: expected no more than max_corners"),
+            std::string::npos)
+      << r.output;
+
+  // A sweep over the plug-in's option beside a built-in VO: planned, each job's scenario with
+  // its value, and the first job run by the user's program.
+  {
+    std::ofstream sweep(root / "corners.yaml");
+    sweep << "name: corners\nbase: "
+          << (test::source_dir() / "tests/data/sweeps/tiny_base.yaml").string()
+          << "\nseed: 3\ndesign: grid\nset:\n  pipeline.vo: [sparse, lk_pnp]\naxes:\n"
+             "  - key: pipeline.plugins.lk_pnp.max_corners\n    values: [40, 200]\n";
+  }
+  r = run_shell(my + " sweep plan " + shell_quote((root / "corners.yaml").string()) + " --out " +
+                shell_quote((root / "sweep").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_shell(my + " sweep run " + shell_quote((root / "sweep").string()) + " -j 1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::vector<std::string> corners;
+  for (const auto& job : fs::directory_iterator(root / "sweep/runs")) {
+    const std::string resolved = test::slurp(job.path() / "scenario.resolved.yaml");
+    for (const char* n : {"40", "200"})
+      if (resolved.find(std::string("max_corners: ") + n + "  #") != std::string::npos)
+        corners.push_back(n);
+    const auto jm = nlohmann::json::parse(test::slurp(job.path() / "metrics.json"));
+    EXPECT_TRUE(jm["algorithms"].contains("lk_pnp")) << job.path();
+  }
+  std::sort(corners.begin(), corners.end());
+  EXPECT_EQ(corners, (std::vector<std::string>{"200", "40"}));
+  r = run_shell(my + " sweep merge " + shell_quote((root / "sweep").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
   // The installed driftlab reads the scene's meshes from the prefix (share/driftlab/assets),
   // not from the source tree; DRIFTLAB_ASSET_DIR overrides both.
   EXPECT_TRUE(fs::exists(prefix / "share/driftlab/assets/bollard.obj"));
@@ -71,10 +149,17 @@ TEST(InstalledPackage, CustomVoProjectBuildsRegistersAndRuns) {
   EXPECT_FALSE(fs::exists(root / "run3"));
 
   // driftlab itself has no lk_pnp: the reader names the choices.
-  const auto plain =
+  auto plain =
       test::run_cli({"scenario", "check", scenario, "-q", "--set", "pipeline.vo=[lk_pnp]"});
   EXPECT_EQ(plain.exit_code, 1);
   EXPECT_NE(plain.err.find("got 'lk_pnp', expected one of: sparse, sparse_kf, pnp, dense"),
+            std::string::npos)
+      << plain.err;
+  plain = test::run_cli(
+      {"scenario", "check", scenario, "-q", "--set", "pipeline.plugins.lk_pnp.max_corners=40"});
+  EXPECT_EQ(plain.exit_code, 1);
+  EXPECT_NE(plain.err.find("pipeline.plugins: got 'lk_pnp', expected the name of a VO registered "
+                           "with options (this program has none)"),
             std::string::npos)
       << plain.err;
   fs::remove_all(root);

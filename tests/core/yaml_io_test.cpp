@@ -447,6 +447,97 @@ TEST(YamlSchema, OptionalEntriesAndOneOfAppearInTheReference) {
   EXPECT_FALSE(back.label.has_value());
 }
 
+// Plug-ins by name, each with an options struct of its own type: "inner" holds an Inner,
+// "point" a Point; "plain" is known but has no options.
+struct WithPlugins {
+  int n = 1;
+  NamedOptions plugins{[](const std::string& name) -> std::unique_ptr<NamedOptions::Holder> {
+                         if (name == "inner") return make_options<Inner>();
+                         if (name == "point") return make_options(Point{.a = 2.5, .b = 1});
+                         return nullptr;
+                       },
+                       [] {
+                         return std::vector<std::string>{"inner", "point"};
+                       }};
+  template <class A>
+  void visit(A& a) {
+    a("n", n, "A count");
+    a("plugins", plugins, "Options by name");
+  }
+};
+
+std::string error_reading(WithPlugins* w, const std::string& text, const std::string& label) {
+  try {
+    read_into(load_string(text, label), {label, true}, w);
+  } catch (const UserError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(YamlNamedOptions, EachNameReadsItsOwnTypeAndALaterReadChangesOnlyItsKeys) {
+  WithPlugins w;
+  EXPECT_TRUE(w.plugins.empty());
+  EXPECT_EQ(error_reading(&w, "plugins:\n  point: {b: 4}\n  inner: {x_m: 3}\n", "p.yaml"), "");
+  const Point* p = options_of<Point>(w.plugins.find("point"));
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->a, 2.5);  // the maker's default, kept
+  EXPECT_EQ(p->b, 4);
+  EXPECT_EQ(options_of<Inner>(w.plugins.find("inner"))->x_m, 3.0);
+  EXPECT_EQ(options_of<Inner>(w.plugins.find("point")), nullptr);  // another type
+  // An override of one key (as --set does) keeps the others and the entries' order.
+  read_into(override_document("plugins.point.a=7"), {"--set plugins.point.a=7", false}, &w);
+  EXPECT_EQ(options_of<Point>(w.plugins.find("point"))->a, 7.0);
+  EXPECT_EQ(options_of<Point>(w.plugins.find("point"))->b, 4);
+  EXPECT_EQ(w.plugins.entries()[0].first, "point");
+  // A copy is deep: changing it leaves the original as it was.
+  WithPlugins copy = w;
+  read_into(override_document("plugins.point.b=9"), {"--set plugins.point.b=9", false}, &copy);
+  EXPECT_EQ(options_of<Point>(w.plugins.find("point"))->b, 4);
+  EXPECT_EQ(options_of<Point>(copy.plugins.find("point"))->b, 9);
+  // Written with every field, and read back to the same values.
+  const std::string text = to_yaml(w, false);
+  EXPECT_NE(text.find("plugins:\n  point:\n    a: 7\n    b: 4\n  inner:\n    x_m: 3\n"),
+            std::string::npos)
+      << text;
+  WithPlugins back;
+  EXPECT_EQ(error_reading(&back, text, "back.yaml"), "");
+  EXPECT_EQ(to_yaml(back, false), text);
+  EXPECT_EQ(to_yaml(WithPlugins{}, false), "n: 1\nplugins: {}\n");
+}
+
+TEST(YamlNamedOptions, ErrorsNameTheKeyPathAndTheReferenceListsEveryName) {
+  WithPlugins w;
+  std::string e = error_reading(&w, "plugins:\n  orb: {x: 1}\n  plain:\n", "p.yaml");
+  EXPECT_NE(e.find("p.yaml:2:3: plugins: got 'orb', expected one of: inner, point"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("got 'plain'"), std::string::npos) << e;
+  e = error_reading(&w, "plugins:\n  point: {b: -1, c: 2}\n  inner: 3\n", "p.yaml");
+  EXPECT_NE(e.find("plugins.point.b: got -1, expected a value >= 0"), std::string::npos) << e;
+  EXPECT_NE(e.find("p.yaml:2:18: plugins.point.c: unknown key (did you mean 'plugins.point.a'?)"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("p.yaml:3:10: plugins.inner: got '3', expected a mapping of keys to values"),
+            std::string::npos)
+      << e;
+  // Validation of a struct built in code reaches into each name's options.
+  WithPlugins bad;
+  read_into(override_document("plugins.inner.x_m=1"), {"--set", false}, &bad);
+  const_cast<Inner&>(*options_of<Inner>(bad.plugins.find("inner"))).x_m = -1;
+  EXPECT_NE(validate(bad).find("plugins.inner.x_m: got -1, expected a value > 0"),
+            std::string::npos)
+      << validate(bad);
+  const auto rows = schema_of(WithPlugins{});
+  std::vector<std::string> keys;
+  for (const auto& r : rows) keys.push_back(r.key_path);
+  EXPECT_EQ(keys, (std::vector<std::string>{"n", "plugins", "plugins.inner", "plugins.inner.x_m",
+                                            "plugins.inner.v", "plugins.point", "plugins.point.a",
+                                            "plugins.point.b"}));
+  EXPECT_EQ(rows[1].constraint, "names: inner, point");
+  EXPECT_EQ(rows[6].default_value, "2.5");  // the maker's defaults
+}
+
 TEST(YamlHelpers, EditDistance) {
   EXPECT_EQ(edit_distance("kitten", "sitting"), 3u);
   EXPECT_EQ(edit_distance("", "abc"), 3u);

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "tests/support/test_support.hpp"
 
 #include "core/error.hpp"
@@ -49,6 +51,53 @@ TEST(VoRegistry, RegistersByNameAndRefusesTakenOrUnsafeNames) {
   const auto vo = make_registered_vo("fixed_test", rig, Rng(1));
   ASSERT_NE(vo, nullptr);
   EXPECT_EQ(vo->process({}).T_prev_curr.translation().x(), 0.3);
+}
+
+struct FixedOptions {
+  double step_m = 0.5;
+  template <class A>
+  void visit(A& a) {
+    a("step_m", step_m, "Step per frame [m]", yaml::positive());
+  }
+};
+
+struct PluginsOnly {  // pipeline.plugins alone
+  yaml::NamedOptions plugins = plugin_options();
+  template <class A>
+  void visit(A& a) {
+    a("plugins", plugins, "");
+  }
+};
+
+TEST(VoRegistry, AVoWithOptionsGetsThemFromPipelinePluginsOrItsDefaults) {
+  register_vo<FixedOptions>("fixed_opts_test", [](const StereoRig&, Rng, const FixedOptions& o) {
+    return std::make_unique<FixedVo>(o.step_m);
+  });
+  yaml::NamedOptions plugins = plugin_options();
+  EXPECT_NE(
+      std::find(plugins.known_names().begin(), plugins.known_names().end(), "fixed_opts_test"),
+      plugins.known_names().end());
+  // Not given: the options struct's defaults.
+  EXPECT_EQ(make_registered_vo("fixed_opts_test", {}, Rng(1), plugins)
+                ->process({})
+                .T_prev_curr.translation()
+                .x(),
+            0.5);
+  PluginsOnly h;
+  yaml::read_into(yaml::override_document("plugins.fixed_opts_test.step_m=2"), {"--set", false},
+                  &h);
+  EXPECT_EQ(make_registered_vo("fixed_opts_test", {}, Rng(1), h.plugins)
+                ->process({})
+                .T_prev_curr.translation()
+                .x(),
+            2.0);
+  EXPECT_NE(error_of([&] {
+              register_vo<FixedOptions>("fixed_opts_test",
+                                        [](const StereoRig&, Rng, const FixedOptions& o) {
+                                          return std::make_unique<FixedVo>(o.step_m);
+                                        });
+            }).find("already registered"),
+            std::string::npos);
 }
 
 }  // namespace
