@@ -43,6 +43,13 @@ const std::vector<RunMetric>& run_metrics() {
       {"basin_north_rmse_m", "basin.north_m.rmse", "basin table: north RMSE [m]"},
       {"basin_east_rmse_m", "basin.east_m.rmse", "basin table: east RMSE [m]"},
       {"basin_heading_rmse_deg", "basin.heading_deg.rmse", "basin table: heading RMSE [deg]"},
+      {"basin_surge_rmse_m_s", "basin.surge_m_s.rmse", "basin table: surge RMSE [m/s]"},
+      {"basin_sway_rmse_m_s", "basin.sway_m_s.rmse", "basin table: sway RMSE [m/s]"},
+      // A VO's tracking, and a filter against the raw VO it follows (missing for the others).
+      {"lost_fraction", "tracking.lost_fraction", "share of frames without a VO motion"},
+      {"filter_vs_raw_ratio", "vs_raw_vo.ratio",
+       "filter's APE translation RMSE / its raw VO's (< 1: it helps)"},
+      {"filter_nonfinite_guards", "filter.nonfinite_guards", "filter's non-finite guards"},
   };
   return metrics;
 }

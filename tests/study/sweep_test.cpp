@@ -435,7 +435,7 @@ TEST(SweepFiles, ShippedSweepsAndTheCiBaselineAreValid) {
   for (const auto& m : b.metrics) EXPECT_TRUE(m.baseline.has_value()) << m.key;
 }
 
-TEST(SweepMerge, RunMetricsIncludeTheBasinTableAndMissingSectionsAreMissing) {
+TEST(SweepMerge, RunMetricsIncludeTheBasinTableAndFilterStatisticsAndMissingIsMissing) {
   const auto metric = [](const std::string& name) {
     for (const auto& rm : run_metrics())
       if (rm.name == name) return rm;
@@ -452,6 +452,15 @@ TEST(SweepMerge, RunMetricsIncludeTheBasinTableAndMissingSectionsAreMissing) {
   EXPECT_TRUE(std::isnan(run_metric_value(run, "pnp", metric("basin_east_rmse_m"))));
   run["algorithms"]["pnp"]["sections"]["count"] = 3;
   EXPECT_EQ(run_metric_value(run, "pnp", metric("p_m_per_m_mean")), 0.0);
+  // The filter statistics: a filter's ratio to its raw VO and its guards; missing for a VO.
+  run["algorithms"]["pnp_ned_kf"]["vs_raw_vo"]["ratio"] = 1.19;
+  run["algorithms"]["pnp_ned_kf"]["filter"]["nonfinite_guards"] = 0;
+  run["algorithms"]["pnp"]["tracking"]["lost_fraction"] = 0.25;
+  EXPECT_EQ(run_metric_value(run, "pnp_ned_kf", metric("filter_vs_raw_ratio")), 1.19);
+  EXPECT_EQ(run_metric_value(run, "pnp_ned_kf", metric("filter_nonfinite_guards")), 0.0);
+  EXPECT_TRUE(std::isnan(run_metric_value(run, "pnp", metric("filter_vs_raw_ratio"))));
+  EXPECT_EQ(run_metric_value(run, "pnp", metric("lost_fraction")), 0.25);
+  EXPECT_TRUE(std::isnan(run_metric_value(run, "pnp_ned_kf", metric("lost_fraction"))));
 }
 
 TEST(SweepMerge, ConfidenceIntervalUsesStudentsT) {
