@@ -2,6 +2,8 @@
 
 #include <optional>
 
+#include "core/rotation.hpp"
+
 namespace driftlab::fusion {
 
 std::int64_t FilterSummary::count(const std::string& name) const {
@@ -13,12 +15,15 @@ std::int64_t FilterSummary::count(const std::string& name) const {
 namespace {
 
 // The NED filters: one step per frame with the VO's body velocities (basin paper Section 3.1)
-// and the latest compass heading since the previous frame.
+// and the latest compass heading since the previous frame. They are planar (north, east,
+// heading); the pose they return takes its height, roll and pitch from the VO they follow,
+// chained from the anchor, so that the pose is compared with the truth on what the filter
+// estimates and a raw VO's own vertical on the rest.
 template <class NedFilter>
 class NedFilterAdapter final : public Filter {
  public:
-  NedFilterAdapter(NedFilter filter, const SE3& T_B_C, bool particles)
-      : filter_(std::move(filter)), T_B_C_(T_B_C), particles_(particles) {}
+  NedFilterAdapter(NedFilter filter, const SE3& T_B_C, const SE3& T_W_B0, bool particles)
+      : filter_(std::move(filter)), T_B_C_(T_B_C), T_W_B_vo_(T_W_B0), particles_(particles) {}
 
   void heading(const HeadingMeasurement& h) override { heading_ = h; }
 
@@ -35,7 +40,12 @@ class NedFilterAdapter final : public Filter {
     const NedEstimate e = filter_.step(m, heading_);
     heading_.reset();
     states_.push_back(e);
-    return e.T_W_B() * T_B_C_;
+    if (dt > 0 && m.valid)  // the VO's own body pose (river paper Eq. (3)), for its vertical
+      T_W_B_vo_ = T_W_B_vo_ * (T_B_C_ * result.T_prev_curr * T_B_C_.inverse());
+    const EulerZYX vo_angles = euler_zyx_from_quat(T_W_B_vo_.quaternion());
+    const SE3 T_W_B(quat_from_euler_zyx({vo_angles.roll_rad, vo_angles.pitch_rad, e.heading_rad()}),
+                    Vec3(e.north_m(), e.east_m(), T_W_B_vo_.translation().z()));
+    return T_W_B * T_B_C_;
   }
 
   FilterSummary summary() const override {
@@ -60,6 +70,7 @@ class NedFilterAdapter final : public Filter {
  private:
   NedFilter filter_;
   SE3 T_B_C_;
+  SE3 T_W_B_vo_;  // the followed VO's body pose, chained from the anchor
   bool particles_;
   bool started_ = false;
   TimeNs t_prev_ns_ = 0;
@@ -135,15 +146,17 @@ class CaSmootherAdapter final : public Filter {
 }  // namespace
 
 std::unique_ptr<Filter> make_ned_kalman_filter(const NedFilterOptions& options,
-                                               const NedState& initial, const SE3& T_B_C) {
+                                               const NedState& initial, const SE3& T_B_C,
+                                               const SE3& T_W_B0) {
   return std::make_unique<NedFilterAdapter<NedKalmanFilter>>(NedKalmanFilter(options, initial),
-                                                             T_B_C, false);
+                                                             T_B_C, T_W_B0, false);
 }
 
 std::unique_ptr<Filter> make_ned_particle_filter(const NedParticleFilterOptions& options, Rng rng,
-                                                 const NedState& initial, const SE3& T_B_C) {
+                                                 const NedState& initial, const SE3& T_B_C,
+                                                 const SE3& T_W_B0) {
   return std::make_unique<NedFilterAdapter<NedParticleFilter>>(
-      NedParticleFilter(options, std::move(rng), initial), T_B_C, true);
+      NedParticleFilter(options, std::move(rng), initial), T_B_C, T_W_B0, true);
 }
 
 std::unique_ptr<Filter> make_eskf(const EskfOptions& options, const EskfExtrinsics& extrinsics,

@@ -57,12 +57,17 @@ class Filter {
 };
 
 /// The basin paper's Kalman filter (Section 3.1.1) on the VO's body velocities and the compass.
-/// `T_B_C`: the left camera's optical frame in body FRD.
+/// `T_B_C`: the left camera's optical frame in body FRD. The filter is planar: the poses it
+/// returns take north, east and heading from it, and height, roll and pitch from the VO it
+/// follows, chained from `T_W_B0` (the body at the first frame).
 std::unique_ptr<Filter> make_ned_kalman_filter(const NedFilterOptions& options,
-                                               const NedState& initial, const SE3& T_B_C);
-/// The basin paper's particle filter (Section 3.1.2); draws only from `rng`.
+                                               const NedState& initial, const SE3& T_B_C,
+                                               const SE3& T_W_B0);
+/// The basin paper's particle filter (Section 3.1.2); draws only from `rng`. Poses as the
+/// Kalman filter's.
 std::unique_ptr<Filter> make_ned_particle_filter(const NedParticleFilterOptions& options, Rng rng,
-                                                 const NedState& initial, const SE3& T_B_C);
+                                                 const NedState& initial, const SE3& T_B_C,
+                                                 const SE3& T_W_B0);
 /// The error-state Kalman filter on the IMU, the VO, the GPS and the compass.
 std::unique_ptr<Filter> make_eskf(const EskfOptions& options, const EskfExtrinsics& extrinsics,
                                   const EskfState& initial);

@@ -250,6 +250,7 @@ void NedParticleFilter::reset() {
   resample_count_ = 0;
   draw_initial_particles();
   last_ = weighted_estimate();
+  if (options_.position == PfPosition::kIntegrated) last_.x.head<2>() = x0_.head<2>();
 }
 
 NedEstimate NedParticleFilter::weighted_estimate() const {
@@ -385,6 +386,17 @@ NedEstimate NedParticleFilter::step(const BodyVelocityMeasurement& vo,
   }
 
   NedEstimate out = weighted_estimate();
+  if (options_.position == PfPosition::kIntegrated) {
+    // Eq. (7)'s mean on the previous estimate, with this step's velocity: the Kalman filter's
+    // predicted position plus the correction its gain makes through the position-velocity
+    // covariance (dt times the velocity's).
+    NedVector moved = last_.x;
+    moved(ned::kSurge) = out.x(ned::kSurge);
+    moved(ned::kSway) = out.x(ned::kSway);
+    if (m.dt > 0.0) propagate_mean(&moved, m.dt, m.yaw_rate * m.dt);
+    out.x(ned::kNorth) = moved(ned::kNorth);
+    out.x(ned::kEast) = moved(ned::kEast);
+  }
   out.t_ns = vo.t_ns;
   out.dt_s = m.dt;
   out.vo_fused = m.vo;

@@ -144,6 +144,16 @@ constexpr auto enum_table(PfLikelihood) {
                     std::pair{PfLikelihood::kPaperAverage, "paper_average"}};
 }
 
+/// Where the particle filter's position estimate comes from.
+enum class PfPosition {
+  kIntegrated,  ///< the weighted mean velocity and heading through the motion model, Eq. (7)
+  kParticles,   ///< Eq. (10): the weighted mean of the particles' positions (the paper)
+};
+constexpr auto enum_table(PfPosition) {
+  return std::array{std::pair{PfPosition::kIntegrated, "integrated"},
+                    std::pair{PfPosition::kParticles, "particles"}};
+}
+
 /// The particle filter: the shared model plus its own fields (one flat YAML section).
 struct NedParticleFilterOptions : NedFilterOptions {
   /// Number of particles N (the paper's 1000).
@@ -157,6 +167,11 @@ struct NedParticleFilterOptions : NedFilterOptions {
   /// |alpha| that is no likelihood; paper_average uses the average with each component's noise
   /// variance. The default (ours) is the Gaussian product, which makes the PF agree with the KF.
   PfLikelihood likelihood = PfLikelihood::kGaussian;
+  /// Position is never measured, so the particles' positions carry only the Monte-Carlo error
+  /// that resampling at every step piles up (path degeneracy: centimetres over a basin tow).
+  /// integrated (ours, the default) moves the previous estimate by the weighted mean velocity
+  /// and heading, as the Kalman filter's prediction does; particles is the paper's Eq. (10).
+  PfPosition position = PfPosition::kIntegrated;
 
   template <class A>
   void visit(A& a) {
@@ -173,6 +188,10 @@ struct NedParticleFilterOptions : NedFilterOptions {
     a("likelihood", likelihood,
       "gaussian: product of the measurement components' densities; paper_average: their "
       "average, Eq. (8)");
+    a("position", position,
+      "integrated: the previous position moved by the weighted mean velocity and heading "
+      "(Eq. (7)); particles: the weighted mean of the particles' positions, Eq. (10) (the paper; "
+      "adds the Monte-Carlo error of the never-measured positions)");
   }
 
   std::string validate() const { return yaml::validate(*this); }

@@ -27,9 +27,9 @@ std::unique_ptr<fusion::Filter> make_ned_filter(FusionAlgorithm kind, const Pipe
   init.east_m = T_W_B0.translation().y();
   init.heading_rad = sensors.compass.front().heading_rad;  // measured, not the truth
   if (kind == FusionAlgorithm::kNedKf)
-    return fusion::make_ned_kalman_filter(p.ned_kf, init, mounts.T_B_C);
-  return fusion::make_ned_particle_filter(p.ned_pf, rng.stream("fusion.ned_pf"), init,
-                                          mounts.T_B_C);
+    return fusion::make_ned_kalman_filter(p.ned_kf, init, mounts.T_B_C, T_W_B0);
+  return fusion::make_ned_particle_filter(p.ned_pf, rng.stream("fusion.ned_pf"), init, mounts.T_B_C,
+                                          T_W_B0);
 }
 
 std::unique_ptr<fusion::Filter> make_eskf_filter(const PipelineOptions& p,
