@@ -177,6 +177,16 @@ std::string EskfStats::brief() const {
 Eskf::Eskf(const Options& options, const EskfExtrinsics& extrinsics, const EskfState& initial)
     : options_(options), extrinsics_(extrinsics), state_(initial) {
   yaml::validate_or_throw(options_, "Eskf");
+  for (const auto& [name, value] :
+       {std::pair{"gyro_noise_density_rad_s_sqrt_hz", options_.gyro_noise_density_rad_s_sqrt_hz},
+        std::pair{"gyro_random_walk_rad_s2_sqrt_hz", options_.gyro_random_walk_rad_s2_sqrt_hz},
+        std::pair{"accel_noise_density_m_s2_sqrt_hz", options_.accel_noise_density_m_s2_sqrt_hz},
+        std::pair{"accel_random_walk_m_s3_sqrt_hz", options_.accel_random_walk_m_s3_sqrt_hz},
+        std::pair{"compass_noise_rad", options_.compass_noise_rad}})
+    if (!value)
+      throw UserError(fmt::format(
+          "Eskf: {}: got null, expected a number (the pipeline fills null from the sensors)",
+          name));
   if (!finite(state_)) throw UserError("Eskf: the initial state must be finite and q non-zero");
   if (!vo::detail::is_finite(extrinsics_.T_I_C) || !extrinsics_.p_I_antenna_m.allFinite() ||
       !extrinsics_.R_I_M.allFinite() ||
@@ -219,10 +229,10 @@ void Eskf::propagate_piece(const Input& a, const Input& b) {
   // Sola Section 5.4.3's Q_i: white noise on velocity and attitude, random walks on the biases
   // (variances density^2 h), plus the position part of the integrated accelerometer noise.
   const auto sq = [](double x) { return x * x; };
-  const double na = sq(options_.accel_noise_density_m_s2_sqrt_hz);
-  const double ng = sq(options_.gyro_noise_density_rad_s_sqrt_hz);
-  const double wa = sq(options_.accel_random_walk_m_s3_sqrt_hz);
-  const double wg = sq(options_.gyro_random_walk_rad_s2_sqrt_hz);
+  const double na = sq(*options_.accel_noise_density_m_s2_sqrt_hz);
+  const double ng = sq(*options_.gyro_noise_density_rad_s_sqrt_hz);
+  const double wa = sq(*options_.accel_random_walk_m_s3_sqrt_hz);
+  const double wg = sq(*options_.gyro_random_walk_rad_s2_sqrt_hz);
   const Mat3 I = Mat3::Identity();
   Mat15 Q = Mat15::Zero();
   Q.block<3, 3>(kP, kP) = (na * h * h * h / 3.0) * I;
@@ -424,7 +434,7 @@ bool Eskf::update_heading(const HeadingMeasurement& heading) {
   H.leftCols<15>() = H15;
   Eigen::Matrix<double, 1, 1> r, R;
   r(0) = wrap_angle_rad(heading.heading_rad - pred);
-  R(0) = options_.compass_noise_rad * options_.compass_noise_rad;
+  R(0) = *options_.compass_noise_rad * *options_.compass_noise_rad;
   const bool fused = fuse<1>(r, H, R, options_.heading_gate_chi2, &stats_.heading_gated);
   if (fused) ++stats_.heading_fused;
   return fused;

@@ -60,15 +60,19 @@ inline constexpr int kAugmentedDim = 21;
 /// and the simulated compass's 1 deg. Priors and gates are ours.
 struct EskfOptions {
   double gravity_m_s2 = 9.80665;
-  double gyro_noise_density_rad_s_sqrt_hz = 1.7453292519943295e-4;  // 0.01 deg/s/sqrt(Hz)
-  double gyro_random_walk_rad_s2_sqrt_hz = 2.0e-5;
-  double accel_noise_density_m_s2_sqrt_hz = 2.941995e-3;  // 300 ug/sqrt(Hz)
-  double accel_random_walk_m_s3_sqrt_hz = 1.5e-4;
+  // IMU and compass noise: null (a scenario's default) is filled in by the pipeline from the
+  // scenario's sensor models (driftlab vo: the dataset's imu0/sensor.yaml); the filter itself
+  // needs numbers.
+  std::optional<double> gyro_noise_density_rad_s_sqrt_hz =
+      1.7453292519943295e-4;  // 0.01 deg/s/sqrt(Hz)
+  std::optional<double> gyro_random_walk_rad_s2_sqrt_hz = 2.0e-5;
+  std::optional<double> accel_noise_density_m_s2_sqrt_hz = 2.941995e-3;  // 300 ug/sqrt(Hz)
+  std::optional<double> accel_random_walk_m_s3_sqrt_hz = 1.5e-4;
   /// Per-frame VO noise along the left camera's optical axes (x right, y down, z forward):
   /// translation of T_prev_curr [m] and its rotation vector [rad].
   std::array<double, 3> vo_translation_noise_m{0.005, 0.005, 0.005};
   std::array<double, 3> vo_rotation_noise_rad{3.5e-4, 3.5e-4, 3.5e-4};
-  double compass_noise_rad = 0.017453292519943295;  // 1 deg
+  std::optional<double> compass_noise_rad = 0.017453292519943295;  // 1 deg
   /// Prior standard deviations around the initial state. Attitude: about the IMU's x and y
   /// axes (roll, pitch, from levelling on gravity) and z (heading, from the compass).
   double initial_position_sd_m = 1.0;
@@ -88,16 +92,20 @@ struct EskfOptions {
     a("gravity_m_s2", gravity_m_s2, "Gravity magnitude, along world down [m/s^2]",
       yaml::positive());
     a("gyro_noise_density_rad_s_sqrt_hz", gyro_noise_density_rad_s_sqrt_hz,
-      "Gyroscope white-noise density (Kalibr gyroscope_noise_density) [rad/s/sqrt(Hz)]",
+      "Gyroscope white-noise density (Kalibr gyroscope_noise_density) [rad/s/sqrt(Hz)]; null: the "
+      "scenario's IMU model (sensors.imu)",
       yaml::positive());
     a("gyro_random_walk_rad_s2_sqrt_hz", gyro_random_walk_rad_s2_sqrt_hz,
-      "Gyroscope bias random walk (Kalibr gyroscope_random_walk) [rad/s^2/sqrt(Hz)]",
+      "Gyroscope bias random walk (Kalibr gyroscope_random_walk) [rad/s^2/sqrt(Hz)]; null: the "
+      "scenario's IMU model (sensors.imu)",
       yaml::positive());
     a("accel_noise_density_m_s2_sqrt_hz", accel_noise_density_m_s2_sqrt_hz,
-      "Accelerometer white-noise density (Kalibr accelerometer_noise_density) [m/s^2/sqrt(Hz)]",
+      "Accelerometer white-noise density (Kalibr accelerometer_noise_density) [m/s^2/sqrt(Hz)]; "
+      "null: the scenario's IMU model (sensors.imu)",
       yaml::positive());
     a("accel_random_walk_m_s3_sqrt_hz", accel_random_walk_m_s3_sqrt_hz,
-      "Accelerometer bias random walk (Kalibr accelerometer_random_walk) [m/s^3/sqrt(Hz)]",
+      "Accelerometer bias random walk (Kalibr accelerometer_random_walk) [m/s^3/sqrt(Hz)]; null: "
+      "the scenario's IMU model (sensors.imu)",
       yaml::positive());
     a("vo_translation_noise_m", vo_translation_noise_m,
       "Standard deviation of a VO increment's translation per left-camera optical axis [m]",
@@ -105,7 +113,8 @@ struct EskfOptions {
     a("vo_rotation_noise_rad", vo_rotation_noise_rad,
       "Standard deviation of a VO increment's rotation vector per left-camera optical axis [rad]",
       yaml::positive());
-    a("compass_noise_rad", compass_noise_rad, "Compass heading noise, standard deviation [rad]",
+    a("compass_noise_rad", compass_noise_rad,
+      "Compass heading noise, standard deviation [rad]; null: from the scenario's compass model",
       yaml::positive());
     a("initial_position_sd_m", initial_position_sd_m,
       "Prior standard deviation of each position component [m]", yaml::positive());

@@ -75,6 +75,11 @@ NedFilterBase::NedFilterBase(const NedFilterOptions& model, const NedState& init
                              const char* who)
     : model_(model), x0_(initial.vector()), who_(who) {
   x0_(ned::kHeading) = wrap_angle_rad(x0_(ned::kHeading));
+  if (!model_.compass_noise_rad)
+    throw UserError(fmt::format(
+        "{}: compass_noise_rad: got null, expected a number (the pipeline fills null from the "
+        "scenario's compass)",
+        who));
   if (!x0_.allFinite()) {
     throw UserError(fmt::format("{}: the initial state must be finite, got [{}, {}, {}, {}, {}]",
                                 who, x0_(0), x0_(1), x0_(2), x0_(3), x0_(4)));
@@ -144,7 +149,7 @@ detail::NedStepModel NedFilterBase::begin_step(const BodyVelocityMeasurement& vo
       const double age_s = ns_to_seconds(t - heading->t_ns);
       m.heading = true;
       m.psi = wrap_angle_rad(heading->heading_rad + m.yaw_rate * age_s);
-      m.r_psi = model_.compass_noise_rad * model_.compass_noise_rad;
+      m.r_psi = *model_.compass_noise_rad * *model_.compass_noise_rad;
     } else {
       ++nonfinite_guards_;
     }

@@ -81,7 +81,9 @@ struct NedFilterOptions {
   /// uncertainty is assumed: (sd dt)^2 enters Q's heading entry [rad/s].
   double unmeasured_yaw_rate_sd_rad_s = 0.05;
   /// Compass heading noise, standard deviation [rad] (1 deg, the simulated compass's default).
-  double compass_noise_rad = 0.017453292519943295;
+  /// Null (a scenario's default) is filled in by the pipeline from the scenario's compass model;
+  /// the filter itself needs a number.
+  std::optional<double> compass_noise_rad = 0.017453292519943295;
   /// false (the paper's linear KF): the rotation of (u, v) into NED uses the heading estimate as
   /// a known value, so Phi has no column for psi. true (ours): an extended KF that adds
   /// d(N, E)/d psi to Phi; the particle filter ignores it (each particle uses its own heading).
@@ -112,7 +114,9 @@ struct NedFilterOptions {
     a("unmeasured_yaw_rate_sd_rad_s", unmeasured_yaw_rate_sd_rad_s,
       "Yaw-rate uncertainty at a step without a valid VO result (the last rate is held) [rad/s]",
       yaml::positive());
-    a("compass_noise_rad", compass_noise_rad, "Compass heading noise, standard deviation [rad]",
+    a("compass_noise_rad", compass_noise_rad,
+      "Compass heading noise, standard deviation [rad]; null: from the scenario's compass model "
+      "(sensors.compass: sigma_deg and field_noise_nt over the horizontal field)",
       yaml::positive());
     a("heading_jacobian", heading_jacobian,
       "Add d(N, E)/d(heading) to the Kalman filter's transition matrix (an extended KF; the "

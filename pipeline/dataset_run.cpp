@@ -103,7 +103,8 @@ SensorData dataset_sensors(const dataset::StereoDataset& d, TimeNs t0) {
 }
 
 // The body is the dataset's IMU frame S (EuRoC's B): the camera's T_BS from the dataset, the
-// compass and GPS antenna from the settings' mounts, taken relative to the settings' IMU.
+// compass and GPS antenna from the settings' mounts, taken relative to the settings' IMU; the
+// IMU noise from the dataset's imu0/sensor.yaml when it has one, else the settings' sensors.imu.
 FilterMounts dataset_mounts(const dataset::StereoDataset& d, const Scenario& settings) {
   const FilterMounts from_settings = filter_mounts(settings);
   const SE3 T_S_B = from_settings.T_B_I.inverse();
@@ -113,6 +114,12 @@ FilterMounts dataset_mounts(const dataset::StereoDataset& d, const Scenario& set
   m.R_B_M = T_S_B.rotation() * from_settings.R_B_M;
   m.p_B_antenna_m = T_S_B * from_settings.p_B_antenna_m;
   m.gps_sigma_horizontal_m = from_settings.gps_sigma_horizontal_m;
+  m.compass_noise_rad = from_settings.compass_noise_rad;
+  m.imu_noise = from_settings.imu_noise;
+  if (d.imu_noise)  // the dataset's Kalibr model (imu0/sensor.yaml) over the settings' IMU
+    m.imu_noise = {d.imu_noise->gyroscope_noise_density, d.imu_noise->gyroscope_random_walk,
+                   d.imu_noise->accelerometer_noise_density,
+                   d.imu_noise->accelerometer_random_walk};
   return m;
 }
 
@@ -162,13 +169,7 @@ std::vector<Track> make_dataset_tracks(const dataset::StereoDataset& d, const Sc
     tracks.push_back(std::move(t));
   }
   if (tracks.empty()) throw UserError("driftlab vo: no VO to run (--algo or pipeline.vo)");
-  PipelineOptions options = settings.pipeline;
-  if (d.imu_noise) {  // the dataset's Kalibr model (imu0/sensor.yaml) over the settings'
-    options.eskf.gyro_noise_density_rad_s_sqrt_hz = d.imu_noise->gyroscope_noise_density;
-    options.eskf.gyro_random_walk_rad_s2_sqrt_hz = d.imu_noise->gyroscope_random_walk;
-    options.eskf.accel_noise_density_m_s2_sqrt_hz = d.imu_noise->accelerometer_noise_density;
-    options.eskf.accel_random_walk_m_s3_sqrt_hz = d.imu_noise->accelerometer_random_walk;
-  }
+  const PipelineOptions& options = settings.pipeline;
   const FilterMounts mounts = dataset_mounts(d, settings);
   const SE3 T_N_C0 = T_N_W * T_W_C0;
   const SE3 T_N_B0 = T_N_C0 * mounts.T_B_C.inverse();

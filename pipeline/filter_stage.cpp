@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/rotation.hpp"
 #include "core/yaml_io.hpp"
 #include "fusion/eskf.hpp"
 #include "fusion/measurements.hpp"
@@ -57,8 +58,42 @@ std::unique_ptr<fusion::Filter> make_eskf_filter(const PipelineOptions& p,
 
 }  // namespace
 
+// The compass heading's noise from its model: the heading noise it adds (sigma_deg) and the
+// field noise on the horizontal field, through which the heading is computed. Magnetic
+// anomalies (steel structures) are slowly varying errors a white-noise model cannot describe and
+// are left out.
+double compass_heading_noise_rad(const sim::CompassOptions& c) {
+  const double horizontal_nt = c.field_intensity_nt * std::cos(deg2rad(c.inclination_deg));
+  const double field = horizontal_nt > 0 ? c.field_noise_nt / horizontal_nt : 0.0;
+  const double sigma = deg2rad(c.sigma_deg);
+  return std::sqrt(sigma * sigma + field * field);
+}
+
+PipelineOptions with_sensor_noise(PipelineOptions p, const FilterMounts& m) {
+  const double compass =
+      m.compass_noise_rad.value_or(*fusion::NedFilterOptions{}.compass_noise_rad);
+  for (std::optional<double>* c :
+       {&p.ned_kf.compass_noise_rad, &p.ned_pf.compass_noise_rad, &p.eskf.compass_noise_rad})
+    if (!*c) *c = compass;
+  const fusion::EskfOptions built_in;
+  const std::array<double, 4> imu = m.imu_noise.value_or(std::array<double, 4>{
+      *built_in.gyro_noise_density_rad_s_sqrt_hz, *built_in.gyro_random_walk_rad_s2_sqrt_hz,
+      *built_in.accel_noise_density_m_s2_sqrt_hz, *built_in.accel_random_walk_m_s3_sqrt_hz});
+  std::optional<double>* fields[] = {
+      &p.eskf.gyro_noise_density_rad_s_sqrt_hz, &p.eskf.gyro_random_walk_rad_s2_sqrt_hz,
+      &p.eskf.accel_noise_density_m_s2_sqrt_hz, &p.eskf.accel_random_walk_m_s3_sqrt_hz};
+  for (std::size_t i = 0; i < 4; ++i)
+    if (!*fields[i]) *fields[i] = imu[i];
+  return p;
+}
+
 FilterMounts filter_mounts(const Scenario& sc) {
   FilterMounts m;
+  const auto& s = sc.sensors;
+  if (s.compass.enabled) m.compass_noise_rad = compass_heading_noise_rad(s.compass);
+  if (s.imu.enabled)
+    m.imu_noise = {s.imu.gyro_noise_density_rad_s_sqrt_hz, s.imu.gyro_random_walk_rad_s2_sqrt_hz,
+                   s.imu.accel_noise_density_m_s2_sqrt_hz, s.imu.accel_random_walk_m_s3_sqrt_hz};
   m.T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
   m.T_B_I = sim::SensorMount::from_options(sc.sensors.imu.mount).T_B_S();
   m.R_B_M = sim::SensorMount::from_options(sc.sensors.compass.mount).R_B_S;
@@ -68,11 +103,12 @@ FilterMounts filter_mounts(const Scenario& sc) {
   return m;
 }
 
-FilterTrack::FilterTrack(FusionAlgorithm kind, const PipelineOptions& options,
+FilterTrack::FilterTrack(FusionAlgorithm kind, const PipelineOptions& pipeline,
                          const FilterMounts& mounts, const SensorData& sensors, const SE3& T_W_B0,
                          const SE3& T_W_C0, const RngStreams& rng)
     : kind_(kind), sensors_(&sensors), gps_sigma_h_(mounts.gps_sigma_horizontal_m) {
   const std::string who = "pipeline.fusion: " + std::string(yaml::enum_name(kind));
+  const PipelineOptions options = with_sensor_noise(pipeline, mounts);
   switch (kind) {
     case FusionAlgorithm::kCaSmoother:
       filter_ = fusion::make_ca_smoother(options.ca_smoother, T_W_C0);

@@ -5,10 +5,12 @@
 // estimates overlay), the start attitude comes from the sensors.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "core/rng.hpp"
 #include "core/se3.hpp"
@@ -35,7 +37,16 @@ struct FilterMounts {
   Mat3 R_B_M = Mat3::Identity();      ///< compass sensor axes
   Vec3 p_B_antenna_m = Vec3::Zero();  ///< GPS antenna phase centre
   double gps_sigma_horizontal_m = 1.5;
+  /// The sensor models' noise, for the filter options left null: the compass heading's standard
+  /// deviation [rad], and the IMU's Kalibr parameters (gyroscope noise density and random walk,
+  /// accelerometer noise density and random walk). Absent: that sensor is off.
+  std::optional<double> compass_noise_rad;
+  std::optional<std::array<double, 4>> imu_noise;
 };
+
+/// `options` with every null sensor noise of the NED filters and the ESKF filled in from
+/// `mounts` (the filters' own built-in values where the sensor is off).
+PipelineOptions with_sensor_noise(PipelineOptions options, const FilterMounts& mounts);
 
 /// The mounts of a scenario's sensors (sensors.*.mount, sensors.gps.antenna_frd_m).
 FilterMounts filter_mounts(const Scenario& sc);

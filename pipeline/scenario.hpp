@@ -97,6 +97,10 @@ struct PipelineOptions {
   /// Options of the VOs the program registered with options (vo/registry.hpp).
   yaml::NamedOptions plugins = vo::plugin_options();
 
+  /// The filters' sensor noise is left null: a run fills it in from the scenario's sensor
+  /// models (FilterTrack, with_sensor_noise()), so that the filters follow the sensors simulated.
+  PipelineOptions();
+
   template <class A>
   void visit(A& a) {
     a("vo", vo,

@@ -179,7 +179,7 @@ RunResult run_eskf(const RunConfig& cfg, std::uint64_t seed) {
   }
   sim::ImuSimulator imu(io, rng);
   sim::CompassOptions co;
-  co.sigma_deg = cfg.noise ? fo.compass_noise_rad / kDeg : 0.0;
+  co.sigma_deg = cfg.noise ? *fo.compass_noise_rad / kDeg : 0.0;
   sim::CompassSimulator compass(co, rng);
   sim::GpsOptions go;
   go.sigma_horizontal_m = cfg.gps_sigma_m;

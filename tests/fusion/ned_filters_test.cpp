@@ -162,7 +162,7 @@ TEST(NedKalmanFilterTest, CovarianceConvergesToTheDiscreteRiccatiSolution) {
   Eigen::Matrix<double, 3, 5> H = Eigen::Matrix<double, 3, 5>::Zero();
   H(0, 2) = H(1, 3) = H(2, 4) = 1.0;
   const NedVector q = q_diag(o, kDt, var_dpsi);
-  const Eigen::Vector3d r(r_uv(o), r_uv(o), o.compass_noise_rad * o.compass_noise_rad);
+  const Eigen::Vector3d r(r_uv(o), r_uv(o), *o.compass_noise_rad * *o.compass_noise_rad);
   const NedMatrix P = solve_riccati(phi_at(psi0, kDt), q, H, r);
   // North and east are never measured: their variance grows without bound; the rest converges.
   for (int i = 2; i < 5; ++i) {
@@ -254,7 +254,7 @@ TEST(NedKalmanFilterTest, EqualsTheBatchLeastSquaresSolutionOfTheSameData) {
                sh = o.initial_heading_sd_rad;
   bp.p0 << sp * sp, sp * sp, sv * sv, sv * sv, sh * sh;
   bp.r_uv = r_uv(o);
-  bp.r_psi = o.compass_noise_rad * o.compass_noise_rad;
+  bp.r_psi = *o.compass_noise_rad * *o.compass_noise_rad;
   bp.F.resize(K + 1);
   bp.b.resize(K + 1);
   bp.q.resize(K + 1);
@@ -351,7 +351,7 @@ LinearRun linear_run(int steps, std::uint64_t seed, const NedFilterOptions& o, d
   for (int k = 0; k < steps; ++k) {
     run.vo.push_back(vo_at(k, 1.0 + rng.normal(0, su), 0.1 + rng.normal(0, su),
                            rng.normal(0.0, o.vo_yaw_increment_noise_rad / kDt), k % 17 != 9));
-    run.heading.push_back(heading_at(k, psi0 + rng.normal(0.0, o.compass_noise_rad)));
+    run.heading.push_back(heading_at(k, psi0 + rng.normal(0.0, *o.compass_noise_rad)));
   }
   return run;
 }
@@ -569,7 +569,7 @@ TEST(NedParticleFilterTest, PaperAverageLikelihoodIsTheAverageOfTheComponentDens
   const BodyVelocityMeasurement m = vo_at(0, 0.1, -0.2, 0.0);
   const HeadingMeasurement h = heading_at(0, 0.02);
   pf.step(m, h);  // first step: no prediction, the particles stay where they were drawn
-  const double ruv = r_uv(po), rp = po.compass_noise_rad * po.compass_noise_rad;
+  const double ruv = r_uv(po), rp = *po.compass_noise_rad * *po.compass_noise_rad;
   auto density = [](double res, double var) {
     return std::exp(-0.5 * res * res / var) / std::sqrt(2.0 * std::numbers::pi * var);
   };
@@ -610,7 +610,7 @@ TEST(NedFiltersTest, TrackATurningVesselBetterThanTheRawMeasurements) {
     const double um = u + rng.normal(0, su), vm = v + rng.normal(0, su);
     const double rm = r + rng.normal(0, o.vo_yaw_increment_noise_rad / kDt);
     std::optional<HeadingMeasurement> h;
-    if (k % 2 == 0) h = heading_at(k, wrap_angle_rad(x(4) + rng.normal(0, o.compass_noise_rad)));
+    if (k % 2 == 0) h = heading_at(k, wrap_angle_rad(x(4) + rng.normal(0, *o.compass_noise_rad)));
     const bool valid = k % 40 != 39;
     const NedEstimate a = kf.step(vo_at(k, um, vm, rm, valid), h);
     const NedEstimate b = pf.step(vo_at(k, um, vm, rm, valid), h);
