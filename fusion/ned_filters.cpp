@@ -314,6 +314,65 @@ void NedParticleFilter::resample() {
   ++resample_count_;
 }
 
+// Eqs. (8)-(9): each particle's weight times the likelihood of this step's measurements;
+// returns the effective sample size after.
+double NedParticleFilter::reweight(const detail::NedStepModel& m) {
+  const std::size_t n = particles_.size();
+  // Eq. (8): likelihood of z_k given each particle, in the log domain (no underflow).
+  const double two_pi = 2.0 * std::numbers::pi;
+  const int components = (m.vo ? 2 : 0) + (m.heading ? 1 : 0);
+  double max_l = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    const NedVector& p = particles_[i];
+    double res[3], var[3];
+    int k = 0;
+    if (m.vo) {
+      res[k] = m.u - p(ned::kSurge);
+      var[k++] = m.r_uv;
+      res[k] = m.v - p(ned::kSway);
+      var[k++] = m.r_uv;
+    }
+    if (m.heading) {
+      res[k] = wrap_angle_rad(m.psi - p(ned::kHeading));
+      var[k++] = m.r_psi;
+    }
+    double l;
+    if (options_.likelihood == PfLikelihood::kGaussian) {
+      l = 0.0;
+      for (int c = 0; c < components; ++c) l -= 0.5 * res[c] * res[c] / var[c];
+    } else {
+      // Avg over the components of N(res; 0, var), as a log-sum-exp.
+      double a[3];
+      double amax = -std::numeric_limits<double>::infinity();
+      for (int c = 0; c < components; ++c) {
+        a[c] = -0.5 * std::log(two_pi * var[c]) - 0.5 * res[c] * res[c] / var[c];
+        amax = std::max(amax, a[c]);
+      }
+      double s = 0.0;
+      for (int c = 0; c < components; ++c) s += std::exp(a[c] - amax);
+      l = amax + std::log(s / components);
+    }
+    log_l_[i] = l;
+    max_l = std::max(max_l, l);
+  }
+  // Eq. (9): normalised weights (times the previous weights, which are uniform after a
+  // resampling).
+  double total = 0.0;
+  for (std::size_t i = 0; i < n; ++i) total += (weights_[i] *= std::exp(log_l_[i] - max_l));
+  if (!(total > 0.0) || !std::isfinite(total)) {
+    // Every particle with weight left is far out in the tails: keep the likelihood alone.
+    ++nonfinite_guards_;
+    total = 0.0;
+    for (std::size_t i = 0; i < n; ++i) total += (weights_[i] = std::exp(log_l_[i] - max_l));
+  }
+  double s2 = 0.0;
+  for (double& w : weights_) {
+    w /= total;
+    s2 += w * w;
+  }
+  return 1.0 / s2;
+}
+
 NedEstimate NedParticleFilter::step(const BodyVelocityMeasurement& vo,
                                     const std::optional<HeadingMeasurement>& heading) {
   const detail::NedStepModel m = begin_step(vo, heading);
@@ -334,61 +393,7 @@ NedEstimate NedParticleFilter::step(const BodyVelocityMeasurement& vo,
   for (double w : weights_) w2 += w * w;
   double ess = 1.0 / w2;
   bool resampled = false;
-  if (m.vo || m.heading) {
-    // Eq. (8): likelihood of z_k given each particle, in the log domain (no underflow).
-    const double two_pi = 2.0 * std::numbers::pi;
-    const int components = (m.vo ? 2 : 0) + (m.heading ? 1 : 0);
-    double max_l = -std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < n; ++i) {
-      const NedVector& p = particles_[i];
-      double res[3], var[3];
-      int k = 0;
-      if (m.vo) {
-        res[k] = m.u - p(ned::kSurge);
-        var[k++] = m.r_uv;
-        res[k] = m.v - p(ned::kSway);
-        var[k++] = m.r_uv;
-      }
-      if (m.heading) {
-        res[k] = wrap_angle_rad(m.psi - p(ned::kHeading));
-        var[k++] = m.r_psi;
-      }
-      double l;
-      if (options_.likelihood == PfLikelihood::kGaussian) {
-        l = 0.0;
-        for (int c = 0; c < components; ++c) l -= 0.5 * res[c] * res[c] / var[c];
-      } else {
-        // Avg over the components of N(res; 0, var), as a log-sum-exp.
-        double a[3];
-        double amax = -std::numeric_limits<double>::infinity();
-        for (int c = 0; c < components; ++c) {
-          a[c] = -0.5 * std::log(two_pi * var[c]) - 0.5 * res[c] * res[c] / var[c];
-          amax = std::max(amax, a[c]);
-        }
-        double s = 0.0;
-        for (int c = 0; c < components; ++c) s += std::exp(a[c] - amax);
-        l = amax + std::log(s / components);
-      }
-      log_l_[i] = l;
-      max_l = std::max(max_l, l);
-    }
-    // Eq. (9): normalised weights (times the previous weights, which are uniform after a
-    // resampling).
-    double total = 0.0;
-    for (std::size_t i = 0; i < n; ++i) total += (weights_[i] *= std::exp(log_l_[i] - max_l));
-    if (!(total > 0.0) || !std::isfinite(total)) {
-      // Every particle with weight left is far out in the tails: keep the likelihood alone.
-      ++nonfinite_guards_;
-      total = 0.0;
-      for (std::size_t i = 0; i < n; ++i) total += (weights_[i] = std::exp(log_l_[i] - max_l));
-    }
-    double s2 = 0.0;
-    for (double& w : weights_) {
-      w /= total;
-      s2 += w * w;
-    }
-    ess = 1.0 / s2;
-  }
+  if (m.vo || m.heading) ess = reweight(m);
 
   NedEstimate out = weighted_estimate();
   if (options_.position == PfPosition::kIntegrated) {

@@ -322,6 +322,7 @@ class NedParticleFilter : public NedFilterBase {
  private:
   void draw_initial_particles();
   void resample();
+  double reweight(const detail::NedStepModel& m);
   NedEstimate weighted_estimate() const;
 
   Options options_;
