@@ -158,14 +158,15 @@ std::vector<Track> make_dataset_tracks(const dataset::StereoDataset& d, const Sc
                                        const std::vector<std::string>& algorithms,
                                        const std::vector<FusionAlgorithm>& fusion,
                                        const SensorData& sensors, const SE3& T_W_C0,
-                                       const SE3& T_N_W, std::size_t frames) {
+                                       const SE3& T_N_W,
+                                       const std::vector<dataset::DatasetFrame>& used) {
   const RngStreams rng(settings.seed);
   std::vector<Track> tracks;
   for (const std::string& a : algorithms) {
     Track t;
     t.name = a;
     t.vo = make_vo(a, d.rig, settings.pipeline, rng);
-    t.results.resize(frames);
+    t.results.resize(used.size());
     tracks.push_back(std::move(t));
   }
   if (tracks.empty()) throw UserError("driftlab vo: no VO to run (--algo or pipeline.vo)");
@@ -179,7 +180,8 @@ std::vector<Track> make_dataset_tracks(const dataset::StereoDataset& d, const Sc
         return std::make_unique<FilterTrack>(f, options, mounts, sensors, T_N_B0, T_N_C0, rng);
       },
       &tracks);
-  for (Track& t : tracks) t.estimate.push_back({0, T_W_C0});  // stamped in the frame loop
+  if (!used.empty())
+    for (Track& t : tracks) t.estimate.push_back({used.front().t_ns, T_W_C0});
   return tracks;
 }
 
@@ -203,7 +205,6 @@ void run_frames(const dataset::StereoDataset& d, const std::vector<dataset::Data
     for (Track& t : tracks) {
       const vo::VoResult r = t.vo ? t.vo->process(frame) : tracks[t.source].results[k];
       if (t.vo) row += vo_csv_cells(r);
-      if (k == 0) t.estimate.front().t_ns = frame.t_ns;
       advance_track(&t, k, k == 0, frame.t_ns, r);
     }
     frames_csv.write(row + "\n");
@@ -211,6 +212,28 @@ void run_frames(const dataset::StereoDataset& d, const std::vector<dataset::Data
   progress.update(used.size());
   progress.finish();
   frames_csv.commit();
+}
+
+// After the frame loop: the filters' poses back from the levelled world N into the dataset's
+// (R_N_W the identity: left as they are, to the bit), then the smoother's backward pass over
+// every VO track when pipeline.ca_smoother asks for it.
+void finish_tracks(const PipelineOptions& pipeline, const std::vector<dataset::DatasetFrame>& used,
+                   const Mat3& R_N_W, std::vector<Track>* tracks_io) {
+  std::vector<Track>& tracks = *tracks_io;
+  if (R_N_W != Mat3::Identity()) {
+    const SE3 T_W_N(Mat3(R_N_W.transpose()), Vec3::Zero());
+    for (Track& t : tracks)
+      if (t.filter)
+        for (std::size_t j = 1; j < t.estimate.size(); ++j)
+          t.estimate[j].T_W_C = T_W_N * t.estimate[j].T_W_C;
+  }
+  if (!runs_backward_pass(pipeline)) return;
+  std::vector<std::optional<TimeNs>> delivered;  // a dataset drops no frame
+  for (const auto& f : used) delivered.push_back(f.t_ns);
+  const std::size_t n_vo = static_cast<std::size_t>(
+      std::count_if(tracks.begin(), tracks.end(), [](const Track& t) { return t.vo != nullptr; }));
+  for (std::size_t i = 0; i < n_vo; ++i)
+    tracks.push_back(rts_smoothed(tracks[i], i, delivered, pipeline.ca_smoother));
 }
 
 // Every track against the dataset's ground truth: metrics.json's algorithms, tables.md and
@@ -306,26 +329,9 @@ DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario
   const SensorData sensors = dataset_sensors(d, used.empty() ? 0 : used.front().t_ns);
   std::vector<Track> tracks = make_dataset_tracks(
       d, settings, options.algorithms.empty() ? settings.pipeline.vo : options.algorithms, fusion,
-      sensors, T_W_C0, levelled ? SE3(world.R_N_W, Vec3::Zero()) : SE3(), used.size());
+      sensors, T_W_C0, levelled ? SE3(world.R_N_W, Vec3::Zero()) : SE3(), used);
   run_frames(d, used, dir.path(), options, &tracks);
-  if (levelled)  // the filters' poses back into the dataset's world
-    for (Track& t : tracks)
-      if (t.filter)
-        for (std::size_t j = 1; j < t.estimate.size(); ++j)
-          t.estimate[j].T_W_C =
-              SE3(Mat3(world.R_N_W.transpose()), Vec3::Zero()) * t.estimate[j].T_W_C;
-  if (runs_backward_pass(settings.pipeline)) {
-    const std::vector<std::optional<TimeNs>> delivered = [&] {
-      std::vector<std::optional<TimeNs>> t;
-      for (const auto& f : used) t.push_back(f.t_ns);
-      return t;
-    }();
-    const std::size_t n_vo =
-        std::count_if(tracks.begin(), tracks.end(), [](const Track& t) { return t.vo != nullptr; });
-    for (std::size_t i = 0; i < n_vo; ++i)
-      tracks.push_back(rts_smoothed(tracks[i], i, delivered, settings.pipeline.ca_smoother));
-  }
-
+  finish_tracks(settings.pipeline, used, levelled ? world.R_N_W : Mat3::Identity(), &tracks);
   write_estimates(tracks, dir.path());
   if (!d.camera_gt.empty()) write_tum(dir.path() / "groundtruth.tum", d.camera_gt);
   metrics["version"] = DRIFTLAB_VERSION;
