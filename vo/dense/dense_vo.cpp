@@ -19,6 +19,30 @@ constexpr int kMinLevelSidePx = 8;
 
 }  // namespace
 
+namespace dense {
+
+DisparityOptions disparity_options(const DenseVoOptions& o) {
+  DisparityOptions d;
+  d.num_disparities = o.sgbm_num_disparities_px;
+  d.block_size = o.sgbm_block_size_px;
+  d.p1 = o.sgbm_p1;
+  d.p2 = o.sgbm_p2;
+  d.disp12_max_diff = o.sgbm_disp12_max_diff_px;
+  d.pre_filter_cap = o.sgbm_pre_filter_cap;
+  d.uniqueness_ratio = o.sgbm_uniqueness_ratio_pct;
+  d.speckle_window = o.sgbm_speckle_window_px;
+  d.speckle_range = o.sgbm_speckle_range_px;
+  d.full_dp = o.sgbm_mode == DenseSgbmMode::kHh;
+  d.downsample = o.effective_sgbm_downsample();
+  d.refine_iterations = o.use_refine_disparity() ? o.refine_iterations : 0;
+  d.refine_window = o.refine_window_px;
+  d.refine_max_change = o.refine_max_change_px;
+  d.refine_max_residual = o.refine_max_residual_grey;
+  return d;
+}
+
+}  // namespace dense
+
 struct DenseStereoOdometry::Impl {
   // What one pair leaves behind: the current pair's, then (swapped) the previous pair's.
   struct FrameData {
@@ -30,21 +54,7 @@ struct DenseStereoOdometry::Impl {
   Impl(const StereoRig& rig_in, const DenseVoOptions& options_in)
       : rig(rig_in), options(options_in) {
     const DenseVoOptions& o = options;
-    dense::DisparityOptions d;
-    d.num_disparities = o.sgbm_num_disparities_px;
-    d.block_size = o.sgbm_block_size_px;
-    d.p1 = o.sgbm_p1;
-    d.p2 = o.sgbm_p2;
-    d.disp12_max_diff = o.sgbm_disp12_max_diff_px;
-    d.pre_filter_cap = o.sgbm_pre_filter_cap;
-    d.uniqueness_ratio = o.sgbm_uniqueness_ratio_pct;
-    d.speckle_window = o.sgbm_speckle_window_px;
-    d.speckle_range = o.sgbm_speckle_range_px;
-    d.full_dp = o.sgbm_mode == DenseSgbmMode::kHh;
-    d.refine_iterations = o.use_refine_disparity() ? o.refine_iterations : 0;
-    d.refine_window = o.refine_window_px;
-    d.refine_max_change = o.refine_max_change_px;
-    stereo = std::make_unique<dense::DisparityEstimator>(d);
+    stereo = std::make_unique<dense::DisparityEstimator>(dense::disparity_options(o));
     for (FrameData* f : {&a, &b}) f->pyramid.configure(rig.camera, o.pyramid_scales);
     selection.min_disparity_px = o.min_disparity_px;
     selection.gradient_mask = o.use_gradient_mask();

@@ -41,9 +41,15 @@
 #include "core/camera.hpp"
 #include "core/rng.hpp"
 #include "vo/dense/dense_options.hpp"
+#include "vo/dense/disparity.hpp"
 #include "vo/stereo_odometry.hpp"
 
 namespace driftlab::vo {
+
+namespace dense {
+/// The disparity estimator's settings that a dense VO with these options uses.
+DisparityOptions disparity_options(const DenseVoOptions& options);
+}  // namespace dense
 
 /// Details of the last process() call, for diagnostics, tests and benchmarks.
 struct DenseFrameStats {

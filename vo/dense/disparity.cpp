@@ -11,23 +11,43 @@
 namespace driftlab::vo::dense {
 
 DisparityEstimator::DisparityEstimator(const DisparityOptions& options) : options_(options) {
+  if (options.downsample < 1)
+    throw InternalError("DisparityEstimator: downsample must be at least 1");
+  // The shrunk pair's search range covers at least the full-resolution one.
+  const int per_level = (options.num_disparities + options.downsample - 1) / options.downsample;
+  const int searched = (per_level + 15) / 16 * 16;
   sgbm_ = cv::StereoSGBM::create(
-      /*minDisparity=*/0, options.num_disparities, options.block_size, options.p1, options.p2,
+      /*minDisparity=*/0, searched, options.block_size, options.p1, options.p2,
       options.disp12_max_diff, options.pre_filter_cap, options.uniqueness_ratio,
       options.speckle_window, options.speckle_range,
       options.full_dp ? cv::StereoSGBM::MODE_HH : cv::StereoSGBM::MODE_SGBM);
 }
 
-void DisparityEstimator::compute(const cv::Mat& left8, const cv::Mat& right8,
-                                 const cv::Mat& left_f32, cv::Mat* disparity) {
-  sgbm_->compute(left8, right8, raw_);
-  // SGBM writes 16 x disparity, and (minDisparity - 1) * 16 = -16 where it found none.
-  disparity->create(raw_.size(), CV_32FC1);
+void DisparityEstimator::match(const cv::Mat& left8, const cv::Mat& right8, cv::Mat* disparity) {
+  const int f = options_.downsample;
+  const bool shrink = f > 1;
+  if (shrink) {
+    const cv::Size small(left8.cols / f, left8.rows / f);
+    cv::resize(left8, small_left_, small, 0.0, 0.0, cv::INTER_AREA);
+    cv::resize(right8, small_right_, small, 0.0, 0.0, cv::INTER_AREA);
+  }
+  sgbm_->compute(shrink ? small_left_ : left8, shrink ? small_right_ : right8, raw_);
+  // SGBM writes 16 x disparity, and (minDisparity - 1) * 16 = -16 where it found none. A shrunk
+  // pair's disparity is in its own pixels: scale it by the width ratio.
+  const float scale = static_cast<float>(left8.cols) / static_cast<float>(raw_.cols) / 16.0f;
+  cv::Mat& out = shrink ? small_disparity_ : *disparity;
+  out.create(raw_.size(), CV_32FC1);
   for (int v = 0; v < raw_.rows; ++v) {
     const std::int16_t* r = raw_.ptr<std::int16_t>(v);
-    float* d = disparity->ptr<float>(v);
-    for (int u = 0; u < raw_.cols; ++u) d[u] = r[u] > 0 ? r[u] * (1.0f / 16.0f) : 0.0f;
+    float* d = out.ptr<float>(v);
+    for (int u = 0; u < raw_.cols; ++u) d[u] = r[u] > 0 ? r[u] * scale : 0.0f;
   }
+  if (shrink) cv::resize(out, *disparity, left8.size(), 0.0, 0.0, cv::INTER_NEAREST);
+}
+
+void DisparityEstimator::compute(const cv::Mat& left8, const cv::Mat& right8,
+                                 const cv::Mat& left_f32, cv::Mat* disparity) {
+  match(left8, right8, disparity);
   if (options_.refine_iterations <= 0) return;
   right8.convertTo(right_f32_, CV_32F);
   // Central differences along the row, as the photometric Jacobians use.
@@ -36,36 +56,44 @@ void DisparityEstimator::compute(const cv::Mat& left8, const cv::Mat& right8,
   refine(left_f32, disparity);
 }
 
-void DisparityEstimator::refine(const cv::Mat& left_f32, cv::Mat* disparity) {
-  const int W = disparity->cols, H = disparity->rows;
+void DisparityEstimator::linearise(const cv::Mat& left_f32, const cv::Mat& disparity) {
+  const int W = disparity.cols, H = disparity.rows;
   ge_.create(H, W, CV_32FC1);
   gg_.create(H, W, CV_32FC1);
+  ee_.create(H, W, CV_32FC1);
+  for (int v = 0; v < H; ++v) {
+    const float* d = disparity.ptr<float>(v);
+    const float* L = left_f32.ptr<float>(v);
+    const float* R = right_f32_.ptr<float>(v);
+    const float* G = right_dx_.ptr<float>(v);
+    float* ge = ge_.ptr<float>(v);
+    float* gg = gg_.ptr<float>(v);
+    float* ee = ee_.ptr<float>(v);
+    for (int u = 0; u < W; ++u) {
+      const float x = static_cast<float>(u) - d[u];
+      if (!(d[u] > 0.0f) || !(x >= 0.0f) || !(x < static_cast<float>(W - 1))) {
+        ge[u] = gg[u] = ee[u] = 0.0f;
+        continue;
+      }
+      const int x0 = static_cast<int>(x);
+      const float a = x - static_cast<float>(x0);
+      const float rw = (1.0f - a) * R[x0] + a * R[x0 + 1];
+      const float g = (1.0f - a) * G[x0] + a * G[x0 + 1];
+      const float e = L[u] - rw;
+      ge[u] = g * e;
+      gg[u] = g * g;
+      ee[u] = e * e;
+    }
+  }
+}
+
+void DisparityEstimator::refine(const cv::Mat& left_f32, cv::Mat* disparity) {
+  const int W = disparity->cols, H = disparity->rows;
   const cv::Size window(options_.refine_window, options_.refine_window);
   // Windows with less gradient energy than 1 grey/px on every pixel keep SGBM's value.
   const float min_energy = static_cast<float>(options_.refine_window * options_.refine_window);
   for (int it = 0; it < options_.refine_iterations; ++it) {
-    for (int v = 0; v < H; ++v) {
-      const float* d = disparity->ptr<float>(v);
-      const float* L = left_f32.ptr<float>(v);
-      const float* R = right_f32_.ptr<float>(v);
-      const float* G = right_dx_.ptr<float>(v);
-      float* ge = ge_.ptr<float>(v);
-      float* gg = gg_.ptr<float>(v);
-      for (int u = 0; u < W; ++u) {
-        const float x = static_cast<float>(u) - d[u];
-        if (!(d[u] > 0.0f) || !(x >= 0.0f) || !(x < static_cast<float>(W - 1))) {
-          ge[u] = gg[u] = 0.0f;
-          continue;
-        }
-        const int x0 = static_cast<int>(x);
-        const float a = x - static_cast<float>(x0);
-        const float rw = (1.0f - a) * R[x0] + a * R[x0 + 1];
-        const float g = (1.0f - a) * G[x0] + a * G[x0 + 1];
-        const float e = L[u] - rw;
-        ge[u] = g * e;
-        gg[u] = g * g;
-      }
-    }
+    linearise(left_f32, *disparity);
     cv::boxFilter(ge_, ge_sum_, CV_32F, window, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
     cv::boxFilter(gg_, gg_sum_, CV_32F, window, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
     for (int v = 0; v < H; ++v) {
@@ -78,12 +106,20 @@ void DisparityEstimator::refine(const cv::Mat& left_f32, cv::Mat* disparity) {
       }
     }
   }
+  // A match is kept when the refinement moved it little and the refined disparity brings the
+  // window's right-image pixels onto the left ones (RMS residual within max_residual).
+  linearise(left_f32, *disparity);
+  cv::boxFilter(ee_, ee_mean_, CV_32F, window, cv::Point(-1, -1), true, cv::BORDER_CONSTANT);
   const float max_change = static_cast<float>(options_.refine_max_change);
+  const float max_ee =
+      static_cast<float>(options_.refine_max_residual * options_.refine_max_residual);
   for (int v = 0; v < H; ++v) {
     float* d = disparity->ptr<float>(v);
     const float* d0 = sgbm_disparity_.ptr<float>(v);
+    const float* mean_ee = ee_mean_.ptr<float>(v);
     for (int u = 0; u < W; ++u)
-      if (d[u] > 0.0f && std::abs(d[u] - d0[u]) > max_change) d[u] = 0.0f;
+      if (d[u] > 0.0f && (std::abs(d[u] - d0[u]) > max_change || !(mean_ee[u] <= max_ee)))
+        d[u] = 0.0f;
   }
 }
 

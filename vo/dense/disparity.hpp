@@ -3,6 +3,8 @@
 // Lucas-Kanade along the rows (ours, see DisparityEstimator::refine).
 #pragma once
 
+#include <limits>
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/mat.hpp>
 
@@ -17,10 +19,18 @@ struct DisparityOptions {
   int uniqueness_ratio = 10;
   int speckle_window = 100;
   int speckle_range = 2;
-  bool full_dp = false;            ///< MODE_HH instead of MODE_SGBM
+  bool full_dp = false;  ///< MODE_HH instead of MODE_SGBM
+  /// SGBM runs on the pair shrunk by this factor (cv::INTER_AREA) with num_disparities /
+  /// downsample disparities (rounded up to a multiple of 16); its disparity is scaled back to
+  /// full resolution by nearest-neighbour lookup, for the refinement to make sub-pixel. 1: SGBM
+  /// on the full pair.
+  int downsample = 1;
   int refine_iterations = 0;       ///< 0: SGBM's own sub-pixel disparity
   int refine_window = 9;           ///< side of the refinement window [px], odd
   double refine_max_change = 1.0;  ///< a larger total change invalidates the pixel [px]
+  /// A refined pixel whose window's RMS residual |L(x) - R(x - d)| exceeds this loses its
+  /// disparity [grey levels]; infinity keeps every pixel.
+  double refine_max_residual = std::numeric_limits<double>::infinity();
 };
 
 /// SGBM plus refinement, with buffers kept between calls. Not thread-safe.
@@ -38,10 +48,18 @@ class DisparityEstimator {
   // and e = L - R_w, minimise sum_window (e + dR/dx(x - d) delta)^2 over delta; the sums are box
   // filters, so an iteration costs a few passes over the image whatever the window.
   void refine(const cv::Mat& left_f32, cv::Mat* disparity);
+  /// Per pixel at the given disparity, with e = L - R_w and g = dR/dx(x - d): g e into ge_, g^2
+  /// into gg_ and e^2 into ee_ (zeros without a disparity or outside the right image).
+  void linearise(const cv::Mat& left_f32, const cv::Mat& disparity);
+
+  /// SGBM on the (possibly shrunk) pair, written as full-resolution disparity [px] with 0 where
+  /// SGBM found none.
+  void match(const cv::Mat& left8, const cv::Mat& right8, cv::Mat* disparity);
 
   DisparityOptions options_;
   cv::Ptr<cv::StereoSGBM> sgbm_;
-  cv::Mat raw_, sgbm_disparity_, right_f32_, right_dx_, ge_, gg_, ge_sum_, gg_sum_;
+  cv::Mat small_left_, small_right_, small_disparity_;
+  cv::Mat raw_, sgbm_disparity_, right_f32_, right_dx_, ge_, gg_, ee_, ge_sum_, gg_sum_, ee_mean_;
 };
 
 }  // namespace driftlab::vo::dense
