@@ -13,6 +13,7 @@
 #include "core/stopwatch.hpp"
 #include "core/yaml_io.hpp"
 #include "eval/evaluate.hpp"
+#include "pipeline/frame_source.hpp"
 #include "pipeline/progress.hpp"
 #include "pipeline/sensor_stage.hpp"
 #include "pipeline/tracks.hpp"
@@ -185,10 +186,10 @@ std::vector<Track> make_dataset_tracks(const dataset::StereoDataset& d, const Sc
   return tracks;
 }
 
-// Every frame through every track (the VOs, then the filters following them), a frames.csv
-// row each.
+// Every frame through every track (the VOs, side by side when `threads` >= 2, then the filters
+// following them), a frames.csv row each.
 void run_frames(const dataset::StereoDataset& d, const std::vector<dataset::DatasetFrame>& used,
-                const fs::path& dir, const DatasetRunOptions& options,
+                const fs::path& dir, const DatasetRunOptions& options, int threads,
                 std::vector<Track>* tracks_io) {
   std::vector<Track>& tracks = *tracks_io;
   AtomicFile frames_csv(dir / "frames.csv");
@@ -202,8 +203,10 @@ void run_frames(const dataset::StereoDataset& d, const std::vector<dataset::Data
     auto [left, right] = dataset::read_pair(d, used[k]);  // rectified when raw
     const vo::StereoFrame frame{used[k].t_ns, left, right};
     std::string row = std::to_string(frame.t_ns);
-    for (Track& t : tracks) {
-      const vo::VoResult r = t.vo ? t.vo->process(frame) : tracks[t.source].results[k];
+    const std::vector<vo::VoResult> vo_results = process_vos(tracks, frame, threads);
+    for (std::size_t i = 0; i < tracks.size(); ++i) {
+      Track& t = tracks[i];
+      const vo::VoResult& r = t.vo ? vo_results[i] : tracks[t.source].results[k];
       if (t.vo) row += vo_csv_cells(r);
       advance_track(&t, k, k == 0, frame.t_ns, r);
     }
@@ -330,7 +333,7 @@ DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario
   std::vector<Track> tracks = make_dataset_tracks(
       d, settings, options.algorithms.empty() ? settings.pipeline.vo : options.algorithms, fusion,
       sensors, T_W_C0, levelled ? SE3(world.R_N_W, Vec3::Zero()) : SE3(), used);
-  run_frames(d, used, dir.path(), options, &tracks);
+  run_frames(d, used, dir.path(), options, run_threads(settings.pipeline.threads), &tracks);
   finish_tracks(settings.pipeline, used, levelled ? world.R_N_W : Mat3::Identity(), &tracks);
   write_estimates(tracks, dir.path());
   if (!d.camera_gt.empty()) write_tum(dir.path() / "groundtruth.tum", d.camera_gt);

@@ -311,11 +311,12 @@ sim::SceneGeometry scene_for_track(const Scenario& sc, const Trajectory& camera_
 
 namespace {
 
-// The frame loop: every delivered frame through every track (VOs, then the filters following
-// them), a frames.csv row each, the exports for the external VOs. Returns the render seconds.
+// The frame loop: every delivered frame through every track (the VOs, side by side when
+// `threads` >= 2, then the filters following them), a frames.csv row each, the exports for
+// the external VOs. Returns the render seconds.
 double run_frame_loop(FrameSource& source, const std::vector<sim::SampleTime>& stamps,
                       const MissionTruth& mission, std::size_t first,
-                      const std::filesystem::path& dir, const RunOptions& options,
+                      const std::filesystem::path& dir, const RunOptions& options, int threads,
                       ExternalVoStage* external, std::vector<Track>* tracks_io) {
   std::vector<Track>& tracks = *tracks_io;
   const Trajectory& camera_gt = mission.camera_gt;
@@ -344,8 +345,10 @@ double run_frame_loop(FrameSource& source, const std::vector<sim::SampleTime>& s
     std::string row = fmt::format("{},{},{},{},{:.3f},{}", t, rad2deg(platform[k].yaw_rad),
                                   rad2deg(platform[k].pitch_rad), rad2deg(platform[k].roll_rad),
                                   render_ms, yaml::format_double(exposure_ms));
-    for (Track& tr : tracks) {
-      const vo::VoResult r = tr.vo ? tr.vo->process(frame) : tracks[tr.source].results[k];
+    const std::vector<vo::VoResult> vo_results = process_vos(tracks, frame, threads);
+    for (std::size_t i = 0; i < tracks.size(); ++i) {
+      Track& tr = tracks[i];
+      const vo::VoResult& r = tr.vo ? vo_results[i] : tracks[tr.source].results[k];
       if (k == sample_frame && tr.vo && r.valid && !tr.vo->last_matches().empty())
         cv::imwrite((dir / "plots" / (tr.name + "_matches.png")).string(),
                     draw_matches(frame, tr.vo->last_matches()));
@@ -432,7 +435,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   std::size_t dropped = 0;
   for (std::size_t k = 0; k < camera_gt.size(); ++k) dropped += stamps[k].dropped ? 1 : 0;
   const double render_s =
-      run_frame_loop(source, stamps, mission, first, dir, options, &external, &tracks);
+      run_frame_loop(source, stamps, mission, first, dir, options, threads, &external, &tracks);
   add_whole_run_tracks(sc, stamps, first, mission, &external, &tracks, metrics, &warnings);
   write_estimates(tracks, dir);
 

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <exception>
+#include <future>
 
 #include "core/yaml_io.hpp"
 
@@ -25,6 +27,40 @@ void add_filter_tracks(const std::vector<FusionAlgorithm>& fusion, std::size_t n
       tracks->push_back(std::move(t));
     }
   }
+}
+
+std::vector<vo::VoResult> process_vos(std::vector<Track>& tracks, const vo::StereoFrame& frame,
+                                      int threads) {
+  std::vector<vo::VoResult> results(tracks.size());
+  std::vector<std::size_t> vos;
+  for (std::size_t i = 0; i < tracks.size(); ++i)
+    if (tracks[i].vo) vos.push_back(i);
+  const std::size_t at_once = static_cast<std::size_t>(std::max(1, threads));
+  for (std::size_t next = 0; next < vos.size(); next += at_once) {
+    const std::size_t batch = std::min(at_once, vos.size() - next);
+    std::vector<std::future<void>> others;
+    for (std::size_t j = 1; j < batch; ++j) {
+      const std::size_t i = vos[next + j];
+      others.push_back(std::async(std::launch::async, [&tracks, &frame, &results, i] {
+        results[i] = tracks[i].vo->process(frame);
+      }));
+    }
+    std::exception_ptr error;
+    try {
+      results[vos[next]] = tracks[vos[next]].vo->process(frame);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    for (std::future<void>& f : others) {
+      try {
+        f.get();
+      } catch (...) {
+        if (!error) error = std::current_exception();
+      }
+    }
+    if (error) std::rethrow_exception(error);
+  }
+  return results;
 }
 
 void advance_track(Track* track, std::size_t k, bool first, TimeNs t, const vo::VoResult& r) {

@@ -45,6 +45,14 @@ void add_filter_tracks(const std::vector<FusionAlgorithm>& fusion, std::size_t n
                        const std::function<std::unique_ptr<FilterTrack>(FusionAlgorithm)>& make,
                        std::vector<Track>* tracks);
 
+/// Every VO track's result on `frame`, by track index (other tracks' entries are left
+/// default). With `threads` >= 2 the VOs run side by side, up to `threads` at a time, the
+/// calling thread one of them: a VO's result depends only on its own state and the frame, so
+/// the results are the same as in turn. A VO's exception reaches the caller after the others
+/// are done.
+std::vector<vo::VoResult> process_vos(std::vector<Track>& tracks, const vo::StereoFrame& frame,
+                                      int threads);
+
 /// One frame of a track (frame index `k`): a VO's result is kept; a smoother or filter starts
 /// at the first delivered frame and then adds a pose (a filter's absolute pose; otherwise the
 /// increment, river paper Eq. (3)).
