@@ -118,8 +118,9 @@ std::string frames_without_timing(const fs::path& dir) {
 }
 
 TEST(Run, SameBytesWhateverTheThreadCount) {
-  // Rendering on a thread of its own (threads: 2) or in turn with the VOs (threads: 1), with
-  // dropped frames and a keyframe VO: the same estimates, tables and per-frame rows.
+  // Rendering on a thread of its own and the two VOs side by side (threads: 2) or all in turn
+  // (threads: 1), with dropped frames and a keyframe VO: the same estimates, tables and
+  // per-frame rows.
   const fs::path a = temp_dir("threads1"), b = temp_dir("threads2");
   Scenario sc = short_crossing(40);
   sc.pipeline.vo = {"sparse", "sparse_kf"};

@@ -1,0 +1,109 @@
+// pipeline/tracks: the VOs of a frame side by side (process_vos).
+#include "pipeline/tracks.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <set>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+
+namespace driftlab::pipeline {
+namespace {
+
+// A VO whose result is a function of its own calls and the frame's time only, which records the
+// thread it ran on, and which throws on the call `throw_on` (0: never).
+class RecordingVo final : public vo::StereoOdometry {
+ public:
+  RecordingVo(int id, int throw_on = 0) : id_(id), throw_on_(throw_on) {}
+  vo::VoResult process(const vo::StereoFrame& frame) override {
+    ++calls_;
+    thread_ = std::this_thread::get_id();
+    // Long enough for the VOs of one frame to overlap when they run side by side.
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (calls_ == throw_on_) throw UserError("vo " + std::to_string(id_) + " failed");
+    vo::VoResult r;
+    r.valid = true;
+    r.T_prev_curr = SE3(Mat3::Identity(), Vec3(id_, calls_, static_cast<double>(frame.t_ns)));
+    r.inliers = 100 * id_ + calls_;
+    done_ = calls_;
+    return r;
+  }
+  void reset() override { calls_ = 0; }
+  std::string name() const override { return "recording" + std::to_string(id_); }
+  std::thread::id thread() const { return thread_; }
+  int done() const { return done_; }
+
+ private:
+  int id_, throw_on_;
+  int calls_ = 0;
+  std::atomic<int> done_{0};
+  std::thread::id thread_;
+};
+
+// Three VO tracks with a filter-like track (no VO) between them.
+std::vector<Track> three_vos(int throw_on_of_second = 0) {
+  std::vector<Track> tracks(4);
+  tracks[0].vo = std::make_unique<RecordingVo>(1);
+  tracks[1].source = 0;  // follows the first VO: process_vos leaves it alone
+  tracks[2].vo = std::make_unique<RecordingVo>(2, throw_on_of_second);
+  tracks[3].vo = std::make_unique<RecordingVo>(3);
+  return tracks;
+}
+
+const RecordingVo& vo_of(const Track& t) { return dynamic_cast<const RecordingVo&>(*t.vo); }
+
+TEST(ProcessVos, SideBySideGivesTheResultsOfTheVosInTurn) {
+  for (int threads : {2, 3, 8}) {
+    std::vector<Track> serial = three_vos(), parallel = three_vos();
+    for (TimeNs t : {TimeNs{10}, TimeNs{20}, TimeNs{30}}) {
+      vo::StereoFrame frame;
+      frame.t_ns = t;
+      const auto a = process_vos(serial, frame, 1);
+      const auto b = process_vos(parallel, frame, threads);
+      ASSERT_EQ(a.size(), 4u);
+      ASSERT_EQ(b.size(), 4u);
+      for (std::size_t i = 0; i < 4; ++i) {
+        EXPECT_EQ(a[i].valid, b[i].valid) << i;
+        EXPECT_EQ(a[i].inliers, b[i].inliers) << i;
+        EXPECT_EQ(a[i].T_prev_curr.translation(), b[i].T_prev_curr.translation()) << i;
+      }
+      EXPECT_FALSE(a[1].valid);  // the track without a VO keeps a default result
+      EXPECT_EQ(a[3].inliers, 300 + static_cast<int>(t / 10));
+      // In turn: every VO on the calling thread. Side by side: the three on three threads
+      // (with 2 threads, two batches: the first and third VO on the caller's thread).
+      const std::thread::id me = std::this_thread::get_id();
+      for (std::size_t i : {0u, 2u, 3u}) EXPECT_EQ(vo_of(serial[i]).thread(), me);
+      const std::set<std::thread::id> used{vo_of(parallel[0]).thread(),
+                                           vo_of(parallel[2]).thread(),
+                                           vo_of(parallel[3]).thread()};
+      EXPECT_EQ(used.size(), threads == 2 ? 2u : 3u) << threads;
+      EXPECT_EQ(vo_of(parallel[0]).thread(), me);
+    }
+  }
+}
+
+TEST(ProcessVos, AVosExceptionReachesTheCallerAfterTheOthersFinish) {
+  for (int threads : {1, 3}) {
+    std::vector<Track> tracks = three_vos(/*throw_on_of_second=*/2);
+    vo::StereoFrame frame;
+    process_vos(tracks, frame, threads);
+    try {
+      process_vos(tracks, frame, threads);
+      FAIL() << "expected the second VO's UserError";
+    } catch (const UserError& e) {
+      EXPECT_STREQ(e.what(), "vo 2 failed");
+    }
+    // The VOs beside it completed their second frame before the exception came out.
+    EXPECT_EQ(vo_of(tracks[0]).done(), 2) << threads;
+    EXPECT_EQ(vo_of(tracks[3]).done(), threads == 1 ? 1 : 2) << threads;
+  }
+}
+
+}  // namespace
+}  // namespace driftlab::pipeline
