@@ -1,7 +1,9 @@
 #include "fusion/measurements.hpp"
 
+#include <algorithm>
 #include <cmath>
 
+#include "core/error.hpp"
 #include "core/rotation.hpp"
 
 namespace driftlab::fusion {
@@ -37,6 +39,48 @@ GpsPositionMeasurement GpsPositionMeasurement::with_sd(TimeNs t_ns, const Vec3& 
                          sd_vertical_m * sd_vertical_m)
                         .asDiagonal();
   return g;
+}
+
+SecondDifferenceNoise::SecondDifferenceNoise(std::size_t channels, std::size_t window,
+                                             std::size_t min_differences)
+    : chains_(channels), window_(window), min_differences_(min_differences) {
+  DRIFTLAB_DEMAND(channels > 0 && window > 0 && min_differences > 0 && min_differences <= window);
+}
+
+void SecondDifferenceNoise::add(std::size_t channel, double x) {
+  DRIFTLAB_DEMAND(channel < chains_.size());
+  Chain& c = chains_[channel];
+  if (!std::isfinite(x)) {  // a broken sample breaks the chain like a gap
+    c = Chain{};
+    return;
+  }
+  if (c.n == 2) {
+    abs_differences_.push_back(std::abs(x - 2.0 * c.x1 + c.x2));
+    if (abs_differences_.size() > window_) abs_differences_.pop_front();
+  }
+  c.x2 = c.x1;
+  c.x1 = x;
+  c.n = std::min(c.n + 1, 2);
+}
+
+void SecondDifferenceNoise::gap() {
+  for (Chain& c : chains_) c = Chain{};
+}
+
+std::optional<double> SecondDifferenceNoise::sigma() const {
+  if (abs_differences_.size() < min_differences_) return std::nullopt;
+  std::vector<double> d(abs_differences_.begin(), abs_differences_.end());
+  const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
+  std::nth_element(d.begin(), mid, d.end());
+  double median = *mid;
+  if (d.size() % 2 == 0) median = 0.5 * (median + *std::max_element(d.begin(), mid));
+  // 0.6745: the standard normal's third quartile, median |N(0, 1)|.
+  return median / (0.6744897501960817 * std::sqrt(6.0));
+}
+
+void SecondDifferenceNoise::reset() {
+  gap();
+  abs_differences_.clear();
 }
 
 }  // namespace driftlab::fusion

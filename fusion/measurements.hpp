@@ -2,6 +2,11 @@
 // VO results, compass samples, GPS fixes (the filters never see ground truth).
 #pragma once
 
+#include <cstddef>
+#include <deque>
+#include <optional>
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "core/se3.hpp"
@@ -47,6 +52,35 @@ struct GpsPositionMeasurement {
   /// Independent errors: sd_horizontal_m on north and east, sd_vertical_m on down.
   static GpsPositionMeasurement with_sd(TimeNs t_ns, const Vec3& p_W_m, double sd_horizontal_m,
                                         double sd_vertical_m);
+};
+
+/// A running estimate of the white noise on sampled signals whose true values change little from
+/// one sample to the next (ours; the NED filters' VO measurement noise from the VO's own
+/// results). Each channel's second differences d_k = x_k - 2 x_{k-1} + x_{k-2} are pooled over
+/// the last `window`; for white noise of standard deviation sigma, d has variance 6 sigma^2, so
+/// sigma = median|d| / (0.6745 sqrt(6)): the median keeps a VO's occasional wrong motion out.
+/// A smooth true signal adds its own second difference (a 0.05 m/s surge oscillation of 0.8 s
+/// sampled at 20 Hz: 0.008 m/s), small against a VO's noise.
+class SecondDifferenceNoise {
+ public:
+  SecondDifferenceNoise(std::size_t channels, std::size_t window = 200,
+                        std::size_t min_differences = 10);
+  /// The next sample of `channel`.
+  void add(std::size_t channel, double x);
+  /// A missing sample: every channel's differences start again (none spans the gap).
+  void gap();
+  /// sigma, once min_differences second differences are pooled; nullopt before.
+  std::optional<double> sigma() const;
+  void reset();
+
+ private:
+  struct Chain {
+    double x1 = 0.0, x2 = 0.0;  // the last two samples, newest first
+    int n = 0;                  // samples since the last gap (capped at 2)
+  };
+  std::vector<Chain> chains_;
+  std::size_t window_, min_differences_;
+  std::deque<double> abs_differences_;
 };
 
 }  // namespace driftlab::fusion

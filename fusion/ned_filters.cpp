@@ -98,6 +98,28 @@ void NedFilterBase::reset_clock() {
   started_ = false;
   t_prev_ns_ = 0;
   last_yaw_rate_ = 0.0;
+  vo_velocity_noise_.reset();
+  vo_yaw_rate_noise_.reset();
+}
+
+NedFilterBase::VoNoise NedFilterBase::vo_noise(const BodyVelocityMeasurement& vo) {
+  const NedFilterOptions built_in;
+  VoNoise n;
+  if (model_.vo_increment_noise_m) {
+    n.velocity_sd = *model_.vo_increment_noise_m / vo.dt_s;
+  } else {
+    vo_velocity_noise_.add(0, vo.surge_m_s);
+    vo_velocity_noise_.add(1, vo.sway_m_s);
+    n.velocity_sd = vo_velocity_noise_.sigma().value_or(*built_in.vo_increment_noise_m / vo.dt_s);
+  }
+  if (model_.vo_yaw_increment_noise_rad) {
+    n.yaw_rate_sd = *model_.vo_yaw_increment_noise_rad / vo.dt_s;
+  } else {
+    vo_yaw_rate_noise_.add(0, vo.yaw_rate_rad_s);
+    n.yaw_rate_sd =
+        vo_yaw_rate_noise_.sigma().value_or(*built_in.vo_yaw_increment_noise_rad / vo.dt_s);
+  }
+  return n;
 }
 
 detail::NedStepModel NedFilterBase::begin_step(const BodyVelocityMeasurement& vo,
@@ -126,14 +148,17 @@ detail::NedStepModel NedFilterBase::begin_step(const BodyVelocityMeasurement& vo
     // input that turns psi; its increment noise scales to this step's length.
     m.yaw_rate = vo.yaw_rate_rad_s;
     last_yaw_rate_ = m.yaw_rate;
-    const double s = model_.vo_yaw_increment_noise_rad * m.dt / vo.dt_s;
+    const VoNoise noise = vo_noise(vo);
+    m.yaw_rate_sd = noise.yaw_rate_sd;
+    const double s = noise.yaw_rate_sd * m.dt;
     psi_input_var = s * s;
     m.vo = true;
     m.u = vo.surge_m_s;
     m.v = vo.sway_m_s;
-    const double sv = model_.vo_increment_noise_m / vo.dt_s;
-    m.r_uv = sv * sv;
+    m.r_uv = noise.velocity_sd * noise.velocity_sd;
   } else {
+    vo_velocity_noise_.gap();
+    vo_yaw_rate_noise_.gap();
     m.yaw_rate = last_yaw_rate_;
     const double s = model_.unmeasured_yaw_rate_sd_rad_s * m.dt;
     psi_input_var = s * s;
@@ -204,6 +229,8 @@ NedEstimate NedKalmanFilter::step(const BodyVelocityMeasurement& vo,
     scalar_update(&x_, &P_, ned::kSurge, m.u - x_(ned::kSurge), m.r_uv);
     scalar_update(&x_, &P_, ned::kSway, m.v - x_(ned::kSway), m.r_uv);
     out.vo_fused = true;
+    out.vo_velocity_sd_m_s = std::sqrt(m.r_uv);
+    out.vo_yaw_rate_sd_rad_s = m.yaw_rate_sd;
   }
   if (m.heading) {
     scalar_update(&x_, &P_, ned::kHeading, wrap_angle_rad(m.psi - x_(ned::kHeading)), m.r_psi);
@@ -412,6 +439,10 @@ NedEstimate NedParticleFilter::step(const BodyVelocityMeasurement& vo,
   out.vo_fused = m.vo;
   out.heading_fused = m.heading;
   out.effective_sample_size = ess;
+  if (m.vo) {
+    out.vo_velocity_sd_m_s = std::sqrt(m.r_uv);
+    out.vo_yaw_rate_sd_rad_s = m.yaw_rate_sd;
+  }
   if (m.vo || m.heading) {
     resampled = options_.resampling == PfResampling::kMultinomial ||
                 ess < options_.ess_threshold * static_cast<double>(n);

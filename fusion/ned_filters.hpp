@@ -73,10 +73,13 @@ struct NedFilterOptions {
   double heading_noise_rad_sqrt_s = 0.002;
   /// Standard deviation of one VO increment's translation along the body x and y axes [m]: the
   /// VO velocity measurement noise of Eq. (4) is this / dt (the sparse VO's 5 mm per frame).
-  double vo_increment_noise_m = 0.005;
+  /// Null (a scenario's default): estimated from the VO's own velocities as the filter runs
+  /// (SecondDifferenceNoise over the last 200 differences; this built-in value until 10 are in).
+  std::optional<double> vo_increment_noise_m = 0.005;
   /// Standard deviation of one VO increment's yaw [rad] (0.02 deg, the sparse VO's target);
-  /// its variance enters Q's heading entry at each step with a valid VO result.
-  double vo_yaw_increment_noise_rad = 3.5e-4;
+  /// its variance enters Q's heading entry at each step with a valid VO result. Null: estimated
+  /// from the VO's own yaw rates, as above.
+  std::optional<double> vo_yaw_increment_noise_rad = 3.5e-4;
   /// At a step without a valid VO result the last yaw rate is held and this much yaw-rate
   /// uncertainty is assumed: (sd dt)^2 enters Q's heading entry [rad/s].
   double unmeasured_yaw_rate_sd_rad_s = 0.05;
@@ -107,10 +110,15 @@ struct NedFilterOptions {
       "Process noise, Eq. (3): random-walk density of heading [rad/sqrt(s)]", yaml::positive());
     a("vo_increment_noise_m", vo_increment_noise_m,
       "Standard deviation of one VO increment's translation along body x and y [m]; the "
-      "velocity measurement noise of Eq. (4) is this / dt",
+      "velocity measurement noise of Eq. (4) is this / dt. null: estimated from the VO's own "
+      "surge and sway as the filter runs (median absolute second difference over the last 200 "
+      "steps; 0.005 m until 10 are in)",
       yaml::positive());
     a("vo_yaw_increment_noise_rad", vo_yaw_increment_noise_rad,
-      "Standard deviation of one VO increment's yaw, the heading input [rad]", yaml::positive());
+      "Standard deviation of one VO increment's yaw, the heading input [rad]. null: estimated "
+      "from the VO's own yaw rates as the filter runs (as vo_increment_noise_m; 3.5e-4 rad "
+      "until 10 are in)",
+      yaml::positive());
     a("unmeasured_yaw_rate_sd_rad_s", unmeasured_yaw_rate_sd_rad_s,
       "Yaw-rate uncertainty at a step without a valid VO result (the last rate is held) [rad/s]",
       yaml::positive());
@@ -211,6 +219,10 @@ struct NedEstimate {
   bool heading_fused = false;          ///< a compass heading was fused at this step
   double effective_sample_size = 0.0;  ///< particle filter: 1 / sum w^2 before resampling
   bool resampled = false;              ///< particle filter: the particles were resampled
+  /// The VO noise this step assumed: velocity [m/s] and yaw-rate [rad/s] standard deviations
+  /// (the options' increments over the VO step, or the running estimates); 0 without a VO.
+  double vo_velocity_sd_m_s = 0.0;
+  double vo_yaw_rate_sd_rad_s = 0.0;
 
   double north_m() const { return x(ned::kNorth); }
   double east_m() const { return x(ned::kEast); }
@@ -229,6 +241,7 @@ struct NedStepModel {
   NedVector q = NedVector::Zero();      ///< diagonal of Q (Eq. (3)) for this step
   bool vo = false;                      ///< fuse u, v
   double u = 0.0, v = 0.0, r_uv = 0.0;  ///< VO velocity measurement and its variance
+  double yaw_rate_sd = 0.0;             ///< the VO yaw rate's standard deviation [rad/s]
   bool heading = false;                 ///< fuse psi
   double psi = 0.0, r_psi = 0.0;        ///< compass heading carried to the step time, its variance
 };
@@ -251,10 +264,20 @@ class NedFilterBase {
   detail::NedStepModel begin_step(const BodyVelocityMeasurement& vo,
                                   const std::optional<HeadingMeasurement>& heading);
   void reset_clock();
+  /// The VO noise of this step: the options' (an increment's sd over the VO step) or, where
+  /// they are null, the running estimates after adding this step's VO values.
+  struct VoNoise {
+    double velocity_sd = 0.0;  ///< [m/s], surge and sway
+    double yaw_rate_sd = 0.0;  ///< [rad/s]
+  };
+  VoNoise vo_noise(const BodyVelocityMeasurement& vo);
   /// Diagonal of the prior covariance.
   NedVector prior_variance() const;
 
   NedFilterOptions model_;
+  // Running estimates of the VO's velocity (surge, sway) and yaw-rate noise, for null options.
+  fusion::SecondDifferenceNoise vo_velocity_noise_{2};
+  fusion::SecondDifferenceNoise vo_yaw_rate_noise_{1};
   NedVector x0_;
   const char* who_;
   bool started_ = false;

@@ -19,6 +19,7 @@
 
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
+#include <boost/math/distributions/normal.hpp>
 
 #include "core/error.hpp"
 #include "core/rng.hpp"
@@ -77,7 +78,7 @@ NedVector q_diag(const NedFilterOptions& o, double dt, double psi_input_var) {
 }
 
 double r_uv(const NedFilterOptions& o) {
-  return (o.vo_increment_noise_m / kDt) * (o.vo_increment_noise_m / kDt);
+  return (*o.vo_increment_noise_m / kDt) * (*o.vo_increment_noise_m / kDt);
 }
 
 void expect_rel_near(double actual, double expected, double rel, const std::string& what) {
@@ -158,7 +159,7 @@ TEST(NedKalmanFilterTest, CovarianceConvergesToTheDiscreteRiccatiSolution) {
     e = kf.step(vo_at(k, 1.0 + rng.normal(0, 0.1), rng.normal(0, 0.1), 0.0), heading_at(k, psi0));
   ASSERT_EQ(e.heading_rad(), psi0);
 
-  const double var_dpsi = o.vo_yaw_increment_noise_rad * o.vo_yaw_increment_noise_rad;
+  const double var_dpsi = *o.vo_yaw_increment_noise_rad * *o.vo_yaw_increment_noise_rad;
   Eigen::Matrix<double, 3, 5> H = Eigen::Matrix<double, 3, 5>::Zero();
   H(0, 2) = H(1, 3) = H(2, 4) = 1.0;
   const NedVector q = q_diag(o, kDt, var_dpsi);
@@ -269,7 +270,7 @@ TEST(NedKalmanFilterTest, EqualsTheBatchLeastSquaresSolutionOfTheSameData) {
       bp.b[kk] = NedVector::Zero();
       bp.b[kk](4) = r * kDt;
       const double var_dpsi =
-          valid ? o.vo_yaw_increment_noise_rad * o.vo_yaw_increment_noise_rad
+          valid ? *o.vo_yaw_increment_noise_rad * *o.vo_yaw_increment_noise_rad
                 : (o.unmeasured_yaw_rate_sd_rad_s * kDt) * (o.unmeasured_yaw_rate_sd_rad_s * kDt);
       bp.q[kk] = q_diag(o, kDt, var_dpsi);
       psi_true += r * kDt;
@@ -347,10 +348,10 @@ struct LinearRun {
 LinearRun linear_run(int steps, std::uint64_t seed, const NedFilterOptions& o, double psi0) {
   LinearRun run;
   Rng rng = RngStreams(seed).stream("test.ned.data");
-  const double su = o.vo_increment_noise_m / kDt;
+  const double su = *o.vo_increment_noise_m / kDt;
   for (int k = 0; k < steps; ++k) {
     run.vo.push_back(vo_at(k, 1.0 + rng.normal(0, su), 0.1 + rng.normal(0, su),
-                           rng.normal(0.0, o.vo_yaw_increment_noise_rad / kDt), k % 17 != 9));
+                           rng.normal(0.0, *o.vo_yaw_increment_noise_rad / kDt), k % 17 != 9));
     run.heading.push_back(heading_at(k, psi0 + rng.normal(0.0, *o.compass_noise_rad)));
   }
   return run;
@@ -596,7 +597,7 @@ TEST(NedFiltersTest, TrackATurningVesselBetterThanTheRawMeasurements) {
   NedParticleFilterOptions po;
   po.resampling = PfResampling::kSystematicEss;
   NedParticleFilter pf(po, rng, NedState{.surge_m_s = u, .sway_m_s = v, .heading_rad = 1.0});
-  const double su = o.vo_increment_noise_m / kDt;
+  const double su = *o.vo_increment_noise_m / kDt;
   NedVector se_kf = NedVector::Zero(), se_pf = NedVector::Zero();
   double se_raw_u = 0, se_raw_psi = 0;
   constexpr int kSteps = 1200;  // a minute at 20 Hz, 275 deg of turn
@@ -608,7 +609,7 @@ TEST(NedFiltersTest, TrackATurningVesselBetterThanTheRawMeasurements) {
       x(4) = wrap_angle_rad(x(4) + r * kDt);
     }
     const double um = u + rng.normal(0, su), vm = v + rng.normal(0, su);
-    const double rm = r + rng.normal(0, o.vo_yaw_increment_noise_rad / kDt);
+    const double rm = r + rng.normal(0, *o.vo_yaw_increment_noise_rad / kDt);
     std::optional<HeadingMeasurement> h;
     if (k % 2 == 0) h = heading_at(k, wrap_angle_rad(x(4) + rng.normal(0, *o.compass_noise_rad)));
     const bool valid = k % 40 != 39;
@@ -639,6 +640,117 @@ TEST(NedFiltersTest, TrackATurningVesselBetterThanTheRawMeasurements) {
     EXPECT_LT((*rms)(0), 0.5);
     EXPECT_LT((*rms)(1), 0.5);
   }
+}
+
+TEST(NedFiltersTest, NullVoNoiseIsEstimatedFromTheVoAndTracksAsWellAsTheTrueNoise) {
+  // The turning vessel above, with VO noise three times the options' built-in values. A filter
+  // with null VO noise estimates it from the VO's own velocities and yaw rates; it must find the
+  // true standard deviations and track as well as a filter told them (the optimal one).
+  NedFilterOptions truth;
+  truth.vo_increment_noise_m = 0.015;
+  truth.vo_yaw_increment_noise_rad = 1e-3;
+  NedFilterOptions estimated;
+  estimated.vo_increment_noise_m.reset();
+  estimated.vo_yaw_increment_noise_rad.reset();
+  Rng rng = RngStreams(33).stream("test.ned.noise");
+  const double u = 1.2, v = -0.1, r = 0.08;
+  const NedState init{.surge_m_s = u, .sway_m_s = v, .heading_rad = 1.0};
+  NedKalmanFilter told(truth, init), guessing(estimated, init);
+  const double su = *truth.vo_increment_noise_m / kDt;
+  const double sr = *truth.vo_yaw_increment_noise_rad / kDt;
+  NedVector x;
+  x << 0.0, 0.0, u, v, 1.0;
+  NedVector se_told = NedVector::Zero(), se_guess = NedVector::Zero();
+  double su_sum = 0.0, sr_sum = 0.0;
+  int n_estimates = 0;
+  constexpr int kSteps = 1200;
+  for (int k = 0; k < kSteps; ++k) {
+    if (k > 0) {
+      const double psi_m = x(4) + 0.5 * r * kDt;
+      x(0) += kDt * (u * std::cos(psi_m) - v * std::sin(psi_m));
+      x(1) += kDt * (u * std::sin(psi_m) + v * std::cos(psi_m));
+      x(4) = wrap_angle_rad(x(4) + r * kDt);
+    }
+    const BodyVelocityMeasurement m =
+        vo_at(k, u + rng.normal(0, su), v + rng.normal(0, su), r + rng.normal(0, sr), k % 40 != 39);
+    std::optional<HeadingMeasurement> h;
+    if (k % 2 == 0) h = heading_at(k, wrap_angle_rad(x(4) + rng.normal(0, 0.0175)));
+    const NedEstimate a = told.step(m, h);
+    const NedEstimate b = guessing.step(m, h);
+    if (k >= 200 && m.valid) {  // once the windows are full (200 differences each)
+      EXPECT_NEAR(b.vo_velocity_sd_m_s, su, 0.2 * su) << k;
+      EXPECT_NEAR(b.vo_yaw_rate_sd_rad_s, sr, 0.3 * sr) << k;
+      su_sum += b.vo_velocity_sd_m_s;
+      sr_sum += b.vo_yaw_rate_sd_rad_s;
+      ++n_estimates;
+    }
+    if (m.valid) {
+      EXPECT_EQ(a.vo_velocity_sd_m_s, su) << k;
+      EXPECT_NEAR(a.vo_yaw_rate_sd_rad_s, sr, 1e-15) << k;
+    }
+    for (int i = 0; i < 5; ++i) {
+      const double da = i == 4 ? wrap_angle_rad(a.x(i) - x(i)) : a.x(i) - x(i);
+      const double db = i == 4 ? wrap_angle_rad(b.x(i) - x(i)) : b.x(i) - x(i);
+      se_told(i) += da * da;
+      se_guess(i) += db * db;
+    }
+  }
+  const NedVector rms_told = (se_told / kSteps).cwiseSqrt();
+  const NedVector rms_guess = (se_guess / kSteps).cwiseSqrt();
+  const double su_mean = su_sum / n_estimates, sr_mean = sr_sum / n_estimates;
+  std::printf(
+      "[  metrics ] KF told the VO noise: RMS N %.3f E %.3f u %.4f psi %.4f; "
+      "estimating it: %.3f %.3f %.4f %.4f; mean estimate %.4f m/s (true %.4f), %.5f "
+      "rad/s (true %.5f)\n",
+      rms_told(0), rms_told(1), rms_told(2), rms_told(4), rms_guess(0), rms_guess(1), rms_guess(2),
+      rms_guess(4), su_mean, su, sr_mean, sr);
+  // The median's own error averages out over the run's overlapping windows.
+  EXPECT_NEAR(su_mean, su, 0.05 * su);
+  EXPECT_NEAR(sr_mean, sr, 0.05 * sr);
+  for (int i = 0; i < 5; ++i) EXPECT_LT(rms_guess(i), 1.1 * rms_told(i)) << i;
+}
+
+TEST(SecondDifferenceNoise, FindsWhiteNoiseOnASmoothSignalDespiteOutliersAndGaps) {
+  // Two channels: 0.8 s oscillations of 0.05 m/s sampled at 20 Hz (surge and sway in waves),
+  // white noise of 0.02, and one sample in 50 made wild.
+  Rng rng = RngStreams(5).stream("test.noise");
+  const double sigma = 0.02;
+  // Each wild sample spoils three differences: a fraction p = 3/50 of them, all above the
+  // median, which moves the median to the (1/2) / (1 - p) quantile of the clean |d|. The 0.8 s
+  // oscillation's second difference (0.008) adds under 1 % to the noise's (0.049).
+  const double p = 3.0 / 50.0;
+  const boost::math::normal_distribution<double> n01;
+  const double expected =
+      sigma * boost::math::quantile(n01, 0.5 + 0.25 / (1.0 - p)) / 0.6744897501960817;
+  SecondDifferenceNoise all(2, 4000), windowed(2);
+  EXPECT_FALSE(windowed.sigma().has_value());
+  for (int k = 0; k < 2000; ++k) {
+    const double t = k * kDt;
+    for (std::size_t c = 0; c < 2; ++c) {
+      double x = 0.05 * std::sin(2.0 * std::numbers::pi * t / 0.8 + static_cast<double>(c)) +
+                 rng.normal(0.0, sigma);
+      if (k % 50 == 7) x += 5.0;
+      x += static_cast<double>((k + 49) / 100);  // a level shift after each gap
+      all.add(c, x);
+      windowed.add(c, x);
+    }
+    if (k % 100 == 50) {  // a level shift across a gap adds no difference
+      all.gap();
+      windowed.gap();
+    }
+    if (k == 5) {
+      EXPECT_FALSE(windowed.sigma().has_value());  // 2 x 4 differences so far
+    }
+    if (k >= 100 && k % 25 == 0) {
+      ASSERT_TRUE(windowed.sigma().has_value());
+      EXPECT_NEAR(*windowed.sigma(), expected, 0.3 * expected) << k;  // 200 differences
+    }
+  }
+  std::printf("[  metrics ] second differences: sigma %.5f, expected %.5f (true %.3f)\n",
+              *all.sigma(), expected, sigma);
+  EXPECT_NEAR(*all.sigma(), expected, 0.04 * expected);
+  all.reset();
+  EXPECT_FALSE(all.sigma().has_value());
 }
 
 // ---------------------------------------------------------------------------------------------

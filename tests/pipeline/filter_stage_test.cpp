@@ -61,3 +61,22 @@ TEST(FilterNoise, NullImuNoiseIsTheImuModelsKalibrParameters) {
 
 }  // namespace
 }  // namespace driftlab::pipeline
+
+namespace driftlab::pipeline {
+namespace {
+
+TEST(FilterNoise, TheParticleFiltersVoNoiseIsEstimatedByDefaultAndTheKalmanFiltersIsFixed) {
+  // The shipped choice (README: the seven basin experiments): ned_pf estimates the VO noise
+  // from the VO's results (null), ned_kf keeps the built-in numbers; both reach the filters
+  // unchanged through with_sensor_noise.
+  const PipelineOptions p = with_sensor_noise(PipelineOptions{}, FilterMounts{});
+  EXPECT_FALSE(p.ned_pf.vo_increment_noise_m.has_value());
+  EXPECT_FALSE(p.ned_pf.vo_yaw_increment_noise_rad.has_value());
+  EXPECT_EQ(p.ned_kf.vo_increment_noise_m, fusion::NedFilterOptions{}.vo_increment_noise_m);
+  EXPECT_EQ(p.ned_kf.vo_yaw_increment_noise_rad,
+            fusion::NedFilterOptions{}.vo_yaw_increment_noise_rad);
+  EXPECT_EQ(p.ned_pf.validate(), "");
+}
+
+}  // namespace
+}  // namespace driftlab::pipeline
