@@ -79,8 +79,7 @@ TEST(ProcessVos, SideBySideGivesTheResultsOfTheVosInTurn) {
       // (with 2 threads, two batches: the first and third VO on the caller's thread).
       const std::thread::id me = std::this_thread::get_id();
       for (std::size_t i : {0u, 2u, 3u}) EXPECT_EQ(vo_of(serial[i]).thread(), me);
-      const std::set<std::thread::id> used{vo_of(parallel[0]).thread(),
-                                           vo_of(parallel[2]).thread(),
+      const std::set<std::thread::id> used{vo_of(parallel[0]).thread(), vo_of(parallel[2]).thread(),
                                            vo_of(parallel[3]).thread()};
       EXPECT_EQ(used.size(), threads == 2 ? 2u : 3u) << threads;
       EXPECT_EQ(vo_of(parallel[0]).thread(), me);
