@@ -587,6 +587,24 @@ TEST(NedParticleFilterTest, PaperAverageLikelihoodIsTheAverageOfTheComponentDens
 // ---------------------------------------------------------------------------------------------
 // A turning vessel with realistic noise
 
+// One step of a vessel turning at a constant rate r with body velocities (u, v): the true
+// state x = [N, E, u, v, psi] moves by kDt (heading at the step's midpoint).
+void advance_turning_truth(NedVector* x, double u, double v, double r) {
+  NedVector& s = *x;
+  const double psi_m = s(4) + 0.5 * r * kDt;
+  s(0) += kDt * (u * std::cos(psi_m) - v * std::sin(psi_m));
+  s(1) += kDt * (u * std::sin(psi_m) + v * std::cos(psi_m));
+  s(4) = wrap_angle_rad(s(4) + r * kDt);
+}
+
+// Adds the squared error of each state of `e` against the truth (heading wrapped) to `se`.
+void add_squared_error(NedVector* se, const NedVector& e, const NedVector& truth) {
+  for (int i = 0; i < 5; ++i) {
+    const double d = i == 4 ? wrap_angle_rad(e(i) - truth(i)) : e(i) - truth(i);
+    (*se)(i) += d * d;
+  }
+}
+
 TEST(NedFiltersTest, TrackATurningVesselBetterThanTheRawMeasurements) {
   const NedFilterOptions o;
   Rng rng = RngStreams(21).stream("test.ned.turn");
@@ -602,12 +620,7 @@ TEST(NedFiltersTest, TrackATurningVesselBetterThanTheRawMeasurements) {
   double se_raw_u = 0, se_raw_psi = 0;
   constexpr int kSteps = 1200;  // a minute at 20 Hz, 275 deg of turn
   for (int k = 0; k < kSteps; ++k) {
-    if (k > 0) {
-      const double psi_m = x(4) + 0.5 * r * kDt;
-      x(0) += kDt * (u * std::cos(psi_m) - v * std::sin(psi_m));
-      x(1) += kDt * (u * std::sin(psi_m) + v * std::cos(psi_m));
-      x(4) = wrap_angle_rad(x(4) + r * kDt);
-    }
+    if (k > 0) advance_turning_truth(&x, u, v, r);
     const double um = u + rng.normal(0, su), vm = v + rng.normal(0, su);
     const double rm = r + rng.normal(0, *o.vo_yaw_increment_noise_rad / kDt);
     std::optional<HeadingMeasurement> h;
@@ -616,12 +629,8 @@ TEST(NedFiltersTest, TrackATurningVesselBetterThanTheRawMeasurements) {
     const NedEstimate a = kf.step(vo_at(k, um, vm, rm, valid), h);
     const NedEstimate b = pf.step(vo_at(k, um, vm, rm, valid), h);
     ASSERT_TRUE(finite(a) && finite(b)) << k;
-    for (int i = 0; i < 5; ++i) {
-      const double da = i == 4 ? wrap_angle_rad(a.x(i) - x(i)) : a.x(i) - x(i);
-      const double db = i == 4 ? wrap_angle_rad(b.x(i) - x(i)) : b.x(i) - x(i);
-      se_kf(i) += da * da;
-      se_pf(i) += db * db;
-    }
+    add_squared_error(&se_kf, a.x, x);
+    add_squared_error(&se_pf, b.x, x);
     se_raw_u += (um - u) * (um - u);
     if (h) se_raw_psi += std::pow(wrap_angle_rad(h->heading_rad - x(4)), 2);
   }
@@ -665,12 +674,7 @@ TEST(NedFiltersTest, NullVoNoiseIsEstimatedFromTheVoAndTracksAsWellAsTheTrueNois
   int n_estimates = 0;
   constexpr int kSteps = 1200;
   for (int k = 0; k < kSteps; ++k) {
-    if (k > 0) {
-      const double psi_m = x(4) + 0.5 * r * kDt;
-      x(0) += kDt * (u * std::cos(psi_m) - v * std::sin(psi_m));
-      x(1) += kDt * (u * std::sin(psi_m) + v * std::cos(psi_m));
-      x(4) = wrap_angle_rad(x(4) + r * kDt);
-    }
+    if (k > 0) advance_turning_truth(&x, u, v, r);
     const BodyVelocityMeasurement m =
         vo_at(k, u + rng.normal(0, su), v + rng.normal(0, su), r + rng.normal(0, sr), k % 40 != 39);
     std::optional<HeadingMeasurement> h;
@@ -688,12 +692,8 @@ TEST(NedFiltersTest, NullVoNoiseIsEstimatedFromTheVoAndTracksAsWellAsTheTrueNois
       EXPECT_EQ(a.vo_velocity_sd_m_s, su) << k;
       EXPECT_NEAR(a.vo_yaw_rate_sd_rad_s, sr, 1e-15) << k;
     }
-    for (int i = 0; i < 5; ++i) {
-      const double da = i == 4 ? wrap_angle_rad(a.x(i) - x(i)) : a.x(i) - x(i);
-      const double db = i == 4 ? wrap_angle_rad(b.x(i) - x(i)) : b.x(i) - x(i);
-      se_told(i) += da * da;
-      se_guess(i) += db * db;
-    }
+    add_squared_error(&se_told, a.x, x);
+    add_squared_error(&se_guess, b.x, x);
   }
   const NedVector rms_told = (se_told / kSteps).cwiseSqrt();
   const NedVector rms_guess = (se_guess / kSteps).cwiseSqrt();
