@@ -64,7 +64,7 @@ struct GpsPositionMeasurement {
 class SecondDifferenceNoise {
  public:
   SecondDifferenceNoise(std::size_t channels, std::size_t window = 200,
-                        std::size_t min_differences = 10);
+                        std::size_t min_differences = 2);
   /// The next sample of `channel`.
   void add(std::size_t channel, double x);
   /// A missing sample: every channel's differences start again (none spans the gap).

@@ -74,7 +74,7 @@ struct NedFilterOptions {
   /// Standard deviation of one VO increment's translation along the body x and y axes [m]: the
   /// VO velocity measurement noise of Eq. (4) is this / dt (the sparse VO's 5 mm per frame).
   /// Null (a scenario's default): estimated from the VO's own velocities as the filter runs
-  /// (SecondDifferenceNoise over the last 200 differences; this built-in value until 10 are in).
+  /// (SecondDifferenceNoise over the last 200 differences; this built-in value until 2 are in).
   std::optional<double> vo_increment_noise_m = 0.005;
   /// Standard deviation of one VO increment's yaw [rad] (0.02 deg, the sparse VO's target);
   /// its variance enters Q's heading entry at each step with a valid VO result. Null: estimated
@@ -112,12 +112,12 @@ struct NedFilterOptions {
       "Standard deviation of one VO increment's translation along body x and y [m]; the "
       "velocity measurement noise of Eq. (4) is this / dt. null: estimated from the VO's own "
       "surge and sway as the filter runs (median absolute second difference over the last 200 "
-      "steps; 0.005 m until 10 are in)",
+      "steps; 0.005 m until 2 are in)",
       yaml::positive());
     a("vo_yaw_increment_noise_rad", vo_yaw_increment_noise_rad,
       "Standard deviation of one VO increment's yaw, the heading input [rad]. null: estimated "
       "from the VO's own yaw rates as the filter runs (as vo_increment_noise_m; 3.5e-4 rad "
-      "until 10 are in)",
+      "until 2 are in)",
       yaml::positive());
     a("unmeasured_yaw_rate_sd_rad_s", unmeasured_yaw_rate_sd_rad_s,
       "Yaw-rate uncertainty at a step without a valid VO result (the last rate is held) [rad/s]",

@@ -20,6 +20,7 @@ PipelineOptions::PipelineOptions() {
        {&ned_kf.compass_noise_rad, &ned_pf.compass_noise_rad, &eskf.compass_noise_rad,
         &eskf.gyro_noise_density_rad_s_sqrt_hz, &eskf.gyro_random_walk_rad_s2_sqrt_hz,
         &eskf.accel_noise_density_m_s2_sqrt_hz, &eskf.accel_random_walk_m_s3_sqrt_hz,
+        &ned_kf.vo_increment_noise_m, &ned_kf.vo_yaw_increment_noise_rad,
         &ned_pf.vo_increment_noise_m, &ned_pf.vo_yaw_increment_noise_rad})
     noise->reset();
 }

@@ -15,11 +15,12 @@
 // method for comparison): SGBM on the pair shrunk 2x (a third of the cost of the full pair),
 // its disparities refined to sub-pixel precision at full resolution by Lucas-Kanade along the
 // rows and checked against the right image (vo/dense/disparity.hpp; SGBM's own interpolation is
-// biased by 0.1-0.3 px, which was the paper method's main error on tests/vo's scenes), t-distribution weights of the residuals
-// (Kerl et al. 2013), the previous motion as initial guess (constant velocity), and a mask that
-// keeps only textured pixels (no water, sky or other flat areas) and optionally drops the lower
-// image. Worst per-frame errors at 0.5 m/frame on tests/vo's sequences: paper 4.8 mm and
-// 0.026 deg, extended 0.4 mm and 0.003 deg (tests/vo/dense_vo_test.cpp prints them).
+// biased by 0.1-0.3 px, which was the paper method's main error on tests/vo's scenes),
+// t-distribution weights of the residuals (Kerl et al. 2013), the previous motion as initial guess
+// (constant velocity), and a mask that keeps only textured pixels (no water, sky or other flat
+// areas) and optionally drops the lower image. Worst per-frame errors at 0.5 m/frame on tests/vo's
+// sequences: paper 4.8 mm and 0.026 deg, extended 0.4 mm and 0.003 deg (tests/vo/dense_vo_test.cpp
+// prints them).
 //
 // A motion is valid when both images are textured, the previous pair has depth, and at least
 // min_inlier_fraction of the textured reference pixels compared at full resolution end within
