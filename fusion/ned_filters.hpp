@@ -111,8 +111,8 @@ struct NedFilterOptions {
     a("vo_increment_noise_m", vo_increment_noise_m,
       "Standard deviation of one VO increment's translation along body x and y [m]; the "
       "velocity measurement noise of Eq. (4) is this / dt. null: estimated from the VO's own "
-      "surge and sway as the filter runs (median absolute second difference over the last 200 "
-      "steps; 0.005 m until 2 are in)",
+      "surge and sway as the filter runs (median absolute second difference over their last 200 "
+      "second differences, pooled; 0.005 m until 2 are in)",
       yaml::positive());
     a("vo_yaw_increment_noise_rad", vo_yaw_increment_noise_rad,
       "Standard deviation of one VO increment's yaw, the heading input [rad]. null: estimated "

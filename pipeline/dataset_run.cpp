@@ -203,7 +203,7 @@ void run_frames(const dataset::StereoDataset& d, const std::vector<dataset::Data
     auto [left, right] = dataset::read_pair(d, used[k]);  // rectified when raw
     const vo::StereoFrame frame{used[k].t_ns, left, right};
     std::string row = std::to_string(frame.t_ns);
-    const std::vector<vo::VoResult> vo_results = process_vos(tracks, frame, threads);
+    const std::vector<vo::VoResult> vo_results = process_vos(&tracks, frame, threads);
     for (std::size_t i = 0; i < tracks.size(); ++i) {
       Track& t = tracks[i];
       const vo::VoResult& r = t.vo ? vo_results[i] : tracks[t.source].results[k];

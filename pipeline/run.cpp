@@ -345,7 +345,7 @@ double run_frame_loop(FrameSource& source, const std::vector<sim::SampleTime>& s
     std::string row = fmt::format("{},{},{},{},{:.3f},{}", t, rad2deg(platform[k].yaw_rad),
                                   rad2deg(platform[k].pitch_rad), rad2deg(platform[k].roll_rad),
                                   render_ms, yaml::format_double(exposure_ms));
-    const std::vector<vo::VoResult> vo_results = process_vos(tracks, frame, threads);
+    const std::vector<vo::VoResult> vo_results = process_vos(&tracks, frame, threads);
     for (std::size_t i = 0; i < tracks.size(); ++i) {
       Track& tr = tracks[i];
       const vo::VoResult& r = tr.vo ? vo_results[i] : tracks[tr.source].results[k];

@@ -29,8 +29,9 @@ void add_filter_tracks(const std::vector<FusionAlgorithm>& fusion, std::size_t n
   }
 }
 
-std::vector<vo::VoResult> process_vos(std::vector<Track>& tracks, const vo::StereoFrame& frame,
+std::vector<vo::VoResult> process_vos(std::vector<Track>* tracks_io, const vo::StereoFrame& frame,
                                       int threads) {
+  std::vector<Track>& tracks = *tracks_io;
   std::vector<vo::VoResult> results(tracks.size());
   std::vector<std::size_t> vos;
   for (std::size_t i = 0; i < tracks.size(); ++i)

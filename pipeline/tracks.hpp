@@ -50,7 +50,7 @@ void add_filter_tracks(const std::vector<FusionAlgorithm>& fusion, std::size_t n
 /// calling thread one of them: a VO's result depends only on its own state and the frame, so
 /// the results are the same as in turn. A VO's exception reaches the caller after the others
 /// are done.
-std::vector<vo::VoResult> process_vos(std::vector<Track>& tracks, const vo::StereoFrame& frame,
+std::vector<vo::VoResult> process_vos(std::vector<Track>* tracks, const vo::StereoFrame& frame,
                                       int threads);
 
 /// One frame of a track (frame index `k`): a VO's result is kept; a smoother or filter starts

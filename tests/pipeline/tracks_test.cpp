@@ -64,8 +64,8 @@ TEST(ProcessVos, SideBySideGivesTheResultsOfTheVosInTurn) {
     for (TimeNs t : {TimeNs{10}, TimeNs{20}, TimeNs{30}}) {
       vo::StereoFrame frame;
       frame.t_ns = t;
-      const auto a = process_vos(serial, frame, 1);
-      const auto b = process_vos(parallel, frame, threads);
+      const auto a = process_vos(&serial, frame, 1);
+      const auto b = process_vos(&parallel, frame, threads);
       ASSERT_EQ(a.size(), 4u);
       ASSERT_EQ(b.size(), 4u);
       for (std::size_t i = 0; i < 4; ++i) {
@@ -91,9 +91,9 @@ TEST(ProcessVos, AVosExceptionReachesTheCallerAfterTheOthersFinish) {
   for (int threads : {1, 3}) {
     std::vector<Track> tracks = three_vos(/*throw_on_of_second=*/2);
     vo::StereoFrame frame;
-    process_vos(tracks, frame, threads);
+    process_vos(&tracks, frame, threads);
     try {
-      process_vos(tracks, frame, threads);
+      process_vos(&tracks, frame, threads);
       FAIL() << "expected the second VO's UserError";
     } catch (const UserError& e) {
       EXPECT_STREQ(e.what(), "vo 2 failed");

@@ -638,6 +638,12 @@ TEST(DenseVoOptionsTest, BadOptionsThrowNamingTheField) {
   o = {};
   o.sgbm_num_disparities_px = 640;
   expect_names(o, "image width");
+  o = {};
+  o.sgbm_num_disparities_px = 624;  // fits the 640 px pair, but not the 160 px one shrunk 4x
+  o.sgbm_downsample = 4;
+  expect_names(o, "sgbm_downsample: got 4, which leaves SGBM a pair 160 px wide to search 160");
+  o.sgbm_downsample = 1;
+  EXPECT_NO_THROW(DenseStereoOdometry(rig, o, vo_rng()));
   StereoRig bad_rig = rig;
   bad_rig.camera.fx = -1.0;
   EXPECT_THROW(DenseStereoOdometry(bad_rig, DenseVoOptions{}, vo_rng()), UserError);

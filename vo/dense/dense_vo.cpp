@@ -101,6 +101,15 @@ DenseStereoOdometry::DenseStereoOdometry(const StereoRig& rig, const DenseVoOpti
                     std::to_string(options.sgbm_num_disparities_px) +
                     ", expected less than the image width " + std::to_string(rig.camera.width));
   }
+  const dense::DisparityOptions d = dense::disparity_options(options);
+  const int shrunk_width = rig.camera.width / d.downsample;
+  if (dense::searched_disparities(d) >= shrunk_width) {
+    throw UserError("DenseStereoOdometry: sgbm_downsample: got " + std::to_string(d.downsample) +
+                    ", which leaves SGBM a pair " + std::to_string(shrunk_width) +
+                    " px wide to search " + std::to_string(dense::searched_disparities(d)) +
+                    " disparities in; expected a smaller sgbm_downsample or "
+                    "sgbm_num_disparities_px");
+  }
   impl_ = std::make_unique<Impl>(rig, options);
 }
 

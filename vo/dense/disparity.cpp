@@ -10,14 +10,16 @@
 
 namespace driftlab::vo::dense {
 
+int searched_disparities(const DisparityOptions& options) {
+  const int per_level = (options.num_disparities + options.downsample - 1) / options.downsample;
+  return (per_level + 15) / 16 * 16;
+}
+
 DisparityEstimator::DisparityEstimator(const DisparityOptions& options) : options_(options) {
   if (options.downsample < 1)
     throw InternalError("DisparityEstimator: downsample must be at least 1");
-  // The shrunk pair's search range covers at least the full-resolution one.
-  const int per_level = (options.num_disparities + options.downsample - 1) / options.downsample;
-  const int searched = (per_level + 15) / 16 * 16;
   sgbm_ = cv::StereoSGBM::create(
-      /*minDisparity=*/0, searched, options.block_size, options.p1, options.p2,
+      /*minDisparity=*/0, searched_disparities(options), options.block_size, options.p1, options.p2,
       options.disp12_max_diff, options.pre_filter_cap, options.uniqueness_ratio,
       options.speckle_window, options.speckle_range,
       options.full_dp ? cv::StereoSGBM::MODE_HH : cv::StereoSGBM::MODE_SGBM);

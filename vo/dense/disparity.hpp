@@ -33,6 +33,10 @@ struct DisparityOptions {
   double refine_max_residual = std::numeric_limits<double>::infinity();
 };
 
+/// The disparities SGBM searches on the (possibly shrunk) pair: num_disparities / downsample,
+/// rounded up to a multiple of 16, so that the full-resolution range is covered.
+int searched_disparities(const DisparityOptions& options);
+
 /// SGBM plus refinement, with buffers kept between calls. Not thread-safe.
 class DisparityEstimator {
  public:
