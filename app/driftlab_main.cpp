@@ -19,6 +19,7 @@
 #include "app/dataset_commands.hpp"
 #include "app/driftlab_main.hpp"
 #include "app/gate_command.hpp"
+#include "app/image_stats_command.hpp"
 #include "app/study_commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -339,6 +340,8 @@ int driftlab_main(int argc, char** argv) {
 
   // export, vo: datasets out and in.
   driftlab::app::DatasetCommands dataset_commands(app);
+  // imagestats: photographs and rendered frames side by side.
+  const driftlab::app::ImageStatsCommand image_stats_command(app);
 
   // sweep plan|run|status|merge|slurm-script, and run --manifest/--job/--shard.
   driftlab::app::StudyCommands study_commands(app);
@@ -352,6 +355,7 @@ int driftlab_main(int argc, char** argv) {
     if (const auto rc = scenario_verbs.dispatch()) return *rc;
     if (const auto rc = study_commands.dispatch()) return *rc;
     if (const auto rc = dataset_commands.dispatch()) return *rc;
+    if (const auto rc = image_stats_command.dispatch()) return *rc;
     if (const auto rc = gate_command.dispatch()) return *rc;
     if (const auto rc = run_verb.dispatch()) return *rc;
     if (const auto rc = render_verb.dispatch()) return *rc;

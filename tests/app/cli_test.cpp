@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -185,7 +186,7 @@ TEST(Cli, KilledRunLeavesNoOutputFolder) {
 }
 
 TEST(Cli, HelpForEverySubcommand) {
-  for (const auto& sub : {"scenario", "run", "render", "eval", "sweep", "regress"}) {
+  for (const auto& sub : {"scenario", "run", "render", "eval", "sweep", "regress", "imagestats"}) {
     const Result r = run_cli({sub, "--help"});
     EXPECT_EQ(r.exit_code, 0) << sub << "\n" << r.output;
     EXPECT_NE(r.output.find("Usage"), std::string::npos) << r.output;
@@ -265,6 +266,51 @@ TEST(CliEval, WritesMetricsSectionsAndTables) {
   EXPECT_NE(negative.exit_code, 0);
   EXPECT_NE(negative.err.find("length_sample_m: got -1"), std::string::npos) << negative.err;
   EXPECT_FALSE(fs::exists(dir / "out1"));
+  fs::remove_all(dir);
+}
+
+// A grey image as binary PGM (P5), which needs no image library to write.
+void write_pgm(const fs::path& path, int width, int height,
+               const std::function<unsigned char(int, int)>& pixel) {
+  std::ofstream out(path, std::ios::binary);
+  out << "P5\n" << width << " " << height << "\n255\n";
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) out.put(static_cast<char>(pixel(x, y)));
+}
+
+TEST(CliImageStats, CountsTheCornersOfACheckerboardAndNamesABadInput) {
+  const fs::path dir = fresh_temp_dir("imagestats");
+  fs::create_directories(dir / "frames");
+  const auto board = [](int x, int y) -> unsigned char {
+    return ((x / 32 + y / 32) % 2 == 0) ? 40 : 200;
+  };
+  write_pgm(dir / "board.pgm", 1024, 768, board);
+  write_pgm(dir / "frames/000000.pgm", 1024, 768, board);
+  write_pgm(dir / "frames/000001.pgm", 1024, 768, board);
+  const Result r = run_cli(
+      {"imagestats", (dir / "board.pgm").string(), "frames=" + (dir / "frames").string(), "--json",
+       (dir / "stats.json").string(), "--montage", (dir / "montage.png").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.out.find("| board | 1 |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| frames | 2 |"), std::string::npos) << r.out;
+  const auto json = nlohmann::json::parse(slurp(dir / "stats.json"));
+  // Inner corners every 32 px: 31 x 23 of them inside the 20 x 15 whole 50x50 cells.
+  EXPECT_NEAR(json["board"]["mean"]["corners_per_cell"].get<double>(), 31.0 * 23.0 / 300.0, 1e-9);
+  EXPECT_EQ(json["frames"]["images"].size(), 2u);
+  EXPECT_TRUE(fs::exists(dir / "montage.png"));
+
+  Result bad = run_cli({"imagestats", (dir / "no_such.png").string()});
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.err.find("no_such.png: no such file or folder"), std::string::npos) << bad.err;
+  fs::create_directories(dir / "empty");
+  bad = run_cli({"imagestats", (dir / "empty").string(), "--out", (dir / "t.md").string()});
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.err.find("no images"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "t.md"));
+  bad = run_cli({"imagestats", (dir / "board.pgm").string(), "--size", "100x50"});
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.err.find("--size: got 100x50; expected at least 200x150"), std::string::npos)
+      << bad.err;
   fs::remove_all(dir);
 }
 
