@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -304,8 +305,14 @@ TEST(ExportFilters, AFilterTheDatasetCannotFeedIsAnErrorWhenAskedForAndSkippedOt
   EXPECT_TRUE(fs::exists(root / "vo/estimates/sparse_ca.tum"));
   EXPECT_FALSE(fs::exists(root / "vo/estimates/sparse_eskf.tum"));
   const auto metrics = nlohmann::json::parse(slurp(root / "vo/metrics.json"));
-  ASSERT_EQ(metrics["warnings"].size(), 1u);
-  EXPECT_NE(metrics["warnings"][0].get<std::string>().find("eskf needs"), std::string::npos);
+  // One warning says so (others, such as a filter no better than its VO, depend on the frames).
+  const auto& warnings = metrics["warnings"];
+  EXPECT_EQ(std::count_if(warnings.begin(), warnings.end(),
+                          [](const nlohmann::json& w) {
+                            return w.get<std::string>().find("eskf needs") != std::string::npos;
+                          }),
+            1)
+      << warnings.dump();
   fs::remove_all(root);
 }
 
