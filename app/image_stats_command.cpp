@@ -6,9 +6,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <iostream>
-#include <regex>
+#include <string_view>
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -65,14 +66,19 @@ Input collect(const std::string& arg, int per_folder) {
   return in;
 }
 
+// WIDTHxHEIGHT, each 1-5 digits.
 eval::ImageStatsOptions parse_size(const std::string& size) {
-  static const std::regex pattern(R"((\d{1,5})x(\d{1,5}))");
-  std::smatch m;
   eval::ImageStatsOptions o;
-  if (!std::regex_match(size, m, pattern))
+  const auto x = size.find('x');
+  const auto digits = [](std::string_view v) {
+    return !v.empty() && v.size() <= 5 &&
+           std::all_of(v.begin(), v.end(), [](unsigned char c) { return std::isdigit(c); });
+  };
+  const std::string_view whole(size);
+  if (x == std::string::npos || !digits(whole.substr(0, x)) || !digits(whole.substr(x + 1)))
     throw UserError(fmt::format("imagestats: --size: got '{}'; expected WIDTHxHEIGHT", size));
-  o.width_px = std::stoi(m[1]);
-  o.height_px = std::stoi(m[2]);
+  o.width_px = std::stoi(size.substr(0, x));
+  o.height_px = std::stoi(size.substr(x + 1));
   if (o.width_px < 200 || o.height_px < 150)
     throw UserError(fmt::format(
         "imagestats: --size: got {}; expected at least 200x150 (the mirror search compares "
