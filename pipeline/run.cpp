@@ -114,7 +114,7 @@ sim::MotionSummary simulate_scenario_motion(
   const double heading = deg2rad(sc.vessel.start_heading_deg);
   sim::MissionContext context;
   context.river_width_m = sc.scene.river_reach.river_width_m;
-  context.survey_leg_length_m = 0.8 * sc.scene.river_reach.reach_length_m;
+  context.survey_leg_length_m = 0.8 * sc.scene.river_reach.reach_length_m;  // river_reach.cpp
   sim::Guidance guidance(model, sim::plan_mission(sc.mission, start, heading, context), sc.mission);
   sim::MotionOptions motion;
   motion.physics_rate_hz = sc.vessel.physics_rate_hz;

@@ -56,23 +56,26 @@ std::vector<MissionSegment> plan_mission(const MissionOptions& m, const Vec2& st
       break;
     }
     case MissionType::kSurvey: {
-      // Lawnmower along the river: legs north and south at +-1/4 of the width,
-      // joined by short crossings, until the planned length is reached.
+      // Lawnmower along the river: legs north and south on two lanes a quarter
+      // of the width from the banks, joined by crossings, until the planned
+      // length is reached. The first lane is the one on the start's side of
+      // the centre line; a start off it joins it along the first leg.
       const double offset = 0.25 * ctx.river_width_m;
+      const double leg = m.survey_leg_length_m > 0 ? m.survey_leg_length_m : ctx.survey_leg_length_m;
+      const double side = start.y() > ctx.river_centre_east_m ? 1.0 : -1.0;
       Vec2 p = start;
+      double lane = ctx.river_centre_east_m + side * offset;
       double remaining = m.survey_length_m;
-      int i = 0;
-      while (remaining > 1e-9) {
+      for (int i = 0; remaining > 1e-9; ++i) {
         const bool along = i % 2 == 0;
-        const int pass = i / 2;
-        Vec2 step = along ? Vec2((pass % 2 == 0 ? 1.0 : -1.0) * ctx.survey_leg_length_m, 0)
-                          : Vec2(0, (pass % 2 == 0 ? 2.0 : -2.0) * offset);
-        const double len = std::min(step.norm(), remaining);
-        step *= len / step.norm();
-        add_leg(&out, p, p + step, m.speed_mps);
-        p += step;
-        remaining -= len;
-        ++i;
+        if (!along) lane = 2 * ctx.river_centre_east_m - lane;  // the other lane
+        const double north = along ? ((i / 2) % 2 == 0 ? 1.0 : -1.0) * leg : 0.0;
+        Vec2 q(p.x() + north, lane);
+        const double len = (q - p).norm();
+        if (len > remaining) q = p + (q - p) * (remaining / len);
+        add_leg(&out, p, q, m.speed_mps);
+        remaining -= std::min(len, remaining);
+        p = q;
       }
       break;
     }

@@ -24,6 +24,7 @@ struct MissionSegment {
 /// Geometry of the world the mission is planned in.
 struct MissionContext {
   double river_width_m = 20.0;
+  double river_centre_east_m = 0.0;  // driftlab's rivers run north along this line
   double survey_leg_length_m = 100.0;
 };
 

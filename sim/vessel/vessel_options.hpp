@@ -219,6 +219,7 @@ struct MissionOptions {
   int crossings = 4;
   double crossing_width_m = 13.5;
   double survey_length_m = 663.0;
+  double survey_leg_length_m = 0.0;
   std::vector<std::array<double, 2>> waypoints_ne_m;
   std::string waypoints_file;
   YawWeaveOptions yaw_weave;
@@ -236,6 +237,10 @@ struct MissionOptions {
       yaml::positive() & yaml::up_to(2000, "no river is wider"));
     a("survey_length_m", survey_length_m, "Track length (type: survey, straight, tow) [m]",
       yaml::positive() & yaml::up_to(100000, "100 km in one run"));
+    a("survey_leg_length_m", survey_leg_length_m,
+      "Length of one leg along the river (type: survey); 0: 80 % of the river reach's "
+      "reach_length_m [m]",
+      yaml::non_negative() & yaml::up_to(100000, "100 km in one run"));
     a("waypoints_ne_m", waypoints_ne_m, "Waypoints, north and east [m] (type: waypoints)",
       yaml::plausible(-1e5, 1e5, "100 km from the world origin: float rendering loses precision"));
     a("waypoints_file", waypoints_file,

@@ -236,6 +236,41 @@ TEST(Vessel, TransectsMissionCrossesTheRiverFourTimes) {
   EXPECT_NEAR(sum.distance_m, 54.0, 2.0);
 }
 
+TEST(Vessel, SurveyLanesKeepAQuarterOfTheWidthFromTheBanks) {
+  MissionOptions m;
+  m.type = MissionType::kSurvey;
+  m.survey_length_m = 150;
+  m.survey_leg_length_m = 30;
+  MissionContext ctx;  // a 20 m river along east = 0: lanes at -5 and +5
+  auto legs_of = [&](const Vec2& start) {
+    std::vector<MissionSegment> legs;
+    for (const auto& g : plan_mission(m, start, 0.0, ctx))
+      if (g.kind == MissionSegment::Kind::kLeg) legs.push_back(g);
+    return legs;
+  };
+  for (const double lane0 : {-5.0, 5.0}) {
+    const auto legs = legs_of(Vec2(3, lane0));
+    // 30 m north, 10 m across, 30 m south, 10 m across, ...: 150 m are 4 legs
+    // and 3 crossings, ending on the other lane where the run began.
+    ASSERT_EQ(legs.size(), 7u);
+    for (std::size_t i = 0; i < legs.size(); ++i) {
+      EXPECT_NEAR(legs[i].to.y(), ((i + 1) / 2) % 2 == 0 ? lane0 : -lane0, 1e-12) << i;
+      const double north = i % 2 ? 0.0 : (i % 4 ? -30.0 : 30.0);
+      EXPECT_NEAR(legs[i].to.x() - legs[i].from.x(), north, 1e-12) << i;
+    }
+    EXPECT_NEAR(legs.back().to.x(), 3.0, 1e-12);
+  }
+  // A start off the lanes joins the lane on its side along the first leg (the
+  // centre line counts as west); the planned length still holds.
+  for (const Vec2& start : {Vec2(0, 0), Vec2(0, 9)}) {
+    const auto legs = legs_of(start);
+    EXPECT_NEAR(legs.front().to.y(), start.y() > 0 ? 5.0 : -5.0, 1e-12);
+    double length = 0;
+    for (const auto& g : legs) length += (g.to - g.from).norm();
+    EXPECT_NEAR(length, 150.0, 1e-9);
+  }
+}
+
 TEST(Vessel, SamplesBetweenPhysicsStepsLieOnTheTrajectory) {
   const VesselModel model(VesselOptions{});
   VesselInputs in;
