@@ -13,9 +13,19 @@ constexpr auto enum_table(RenderBackend) {
                     std::pair{RenderBackend::kEgl, "egl"}};
 }
 
+// The size of the water's reflection pass against the camera's image.
+enum class ReflectionResolution { kHalf, kHalfHeight, kFull };
+constexpr auto enum_table(ReflectionResolution) {
+  return std::array{std::pair{ReflectionResolution::kHalf, "half"},
+                    std::pair{ReflectionResolution::kHalfHeight, "half_height"},
+                    std::pair{ReflectionResolution::kFull, "full"}};
+}
+
 struct RenderOptions {
   RenderBackend backend = RenderBackend::kOsmesa;
   int msaa_samples = 1;
+  ReflectionResolution reflection_resolution = ReflectionResolution::kFull;
+  int reflection_msaa_samples = 1;
   bool ground_truth_depth = false;
   bool reflections = true;
   int motion_blur_samples = 1;
@@ -25,6 +35,13 @@ struct RenderOptions {
     a("backend", backend, "OpenGL context backend");
     a("msaa_samples", msaa_samples,
       "Multisample anti-aliasing samples (1 = off; 4 costs about 3x on llvmpipe, see README)",
+      yaml::in_range(1, 16));
+    a("reflection_resolution", reflection_resolution,
+      "Size of the water's reflection pass: full (the camera's; mirror images move by their "
+      "true sub-pixel amounts), half_height (full width, half the rows) or half (a quarter of "
+      "the fill, but the mirror image's motion snaps to steps of up to 2 px; see README)");
+    a("reflection_msaa_samples", reflection_msaa_samples,
+      "Multisample anti-aliasing samples of the water's reflection pass (1 = off)",
       yaml::in_range(1, 16));
     a("ground_truth_depth", ground_truth_depth, "Also render per-pixel ground-truth depth");
     a("reflections", reflections,

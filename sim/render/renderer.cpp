@@ -130,6 +130,7 @@ struct StereoRenderer::Impl {
   std::vector<float> ripple_a;  // 4 per ripple: kx, ky, omega, slope amplitude
   std::vector<float> ripple_phase;
   int refl_levels = 1;
+  int refl_width = 0, refl_height = 0;  // the reflection pass's size
   // Framebuffers.
   // Framebuffers, one set per eye: both eyes are drawn before either is read
   // back, so llvmpipe rasterises the left eye while the right eye's vertices
@@ -138,6 +139,9 @@ struct StereoRenderer::Impl {
     GLuint msaa_fbo = 0, msaa_color = 0, msaa_depth = 0;
     GLuint resolve_fbo = 0, resolve_tex = 0;
     GLuint refl_fbo = 0, refl_tex = 0, refl_depth = 0;
+    // The reflection pass with render.reflection_msaa_samples > 1: drawn here, resolved into
+    // refl_tex.
+    GLuint refl_msaa_fbo = 0, refl_msaa_color = 0, refl_msaa_depth = 0;
   };
   std::array<EyeTargets, 2> eyes;
   GLuint depth_fbo = 0, depth_tex = 0, depth_rb = 0;
@@ -149,6 +153,8 @@ struct StereoRenderer::Impl {
   void build_eye_targets(EyeTargets* e);
   void color_target_(GLuint* fbo, GLuint* tex, unsigned format, GLuint* depth_rb, int W, int H,
                      int levels = 1);
+  // A colour (R8) and depth renderbuffer pair with `samples` samples (1: single-sampled).
+  void multisample_target_(GLuint* fbo, GLuint* color, GLuint* depth, int samples, int W, int H);
   void draw_scene(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, float mirror, int mode);
   void draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, double t, int mode,
                   GLuint reflection);  // 0: none
@@ -268,6 +274,9 @@ void StereoRenderer::Impl::color_target_(GLuint* fbo, GLuint* tex, unsigned form
 
 void StereoRenderer::Impl::build_framebuffers() {
   const int W = rig.camera.width, H = rig.camera.height;
+  const ReflectionResolution r = options.reflection_resolution;
+  refl_width = r == ReflectionResolution::kHalf ? (W + 1) / 2 : W;
+  refl_height = r == ReflectionResolution::kFull ? H : (H + 1) / 2;
   for (EyeTargets& e : eyes) build_eye_targets(&e);
   color_target_(&depth_fbo, &depth_tex, GL_R32F, &depth_rb, W, H);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -276,28 +285,38 @@ void StereoRenderer::Impl::build_framebuffers() {
 void StereoRenderer::Impl::build_eye_targets(EyeTargets* e) {
   const int W = rig.camera.width, H = rig.camera.height;
   const int samples = options.msaa_samples;
-  glGenFramebuffers(1, &e->msaa_fbo);
-  glBindFramebuffer(GL_FRAMEBUFFER, e->msaa_fbo);
-  glGenRenderbuffers(1, &e->msaa_color);
-  glBindRenderbuffer(GL_RENDERBUFFER, e->msaa_color);
+  multisample_target_(&e->msaa_fbo, &e->msaa_color, &e->msaa_depth, samples, W, H);
+
+  color_target_(&e->resolve_fbo, &e->resolve_tex, GL_R8, nullptr, W, H);
+  // The reflection pass (render.reflection_resolution): at full resolution
+  // by default; at half resolution it costs a quarter of the fill, but its
+  // edges snap the mirror image's sub-pixel motion to steps of two pixels,
+  // which its own MSAA (render.reflection_msaa_samples) only halves. Its mip
+  // levels (made only when wind ripples blur it) are the rough-mirror blur.
+  const int RW = refl_width, RH = refl_height;
+  refl_levels = 1 + static_cast<int>(std::floor(std::log2(std::max(RW, RH))));
+  color_target_(&e->refl_fbo, &e->refl_tex, GL_R8, &e->refl_depth, RW, RH, refl_levels);
+  if (options.reflection_msaa_samples > 1)
+    multisample_target_(&e->refl_msaa_fbo, &e->refl_msaa_color, &e->refl_msaa_depth,
+                        options.reflection_msaa_samples, RW, RH);
+}
+
+void StereoRenderer::Impl::multisample_target_(GLuint* fbo, GLuint* color, GLuint* depth,
+                                               int samples, int W, int H) {
+  glGenFramebuffers(1, fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
+  glGenRenderbuffers(1, color);
+  glBindRenderbuffer(GL_RENDERBUFFER, *color);
   glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, GL_R8, W, H);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, e->msaa_color);
-  glGenRenderbuffers(1, &e->msaa_depth);
-  glBindRenderbuffer(GL_RENDERBUFFER, e->msaa_depth);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, *color);
+  glGenRenderbuffers(1, depth);
+  glBindRenderbuffer(GL_RENDERBUFFER, *depth);
   glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0,
                                    GL_DEPTH_COMPONENT32F, W, H);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, e->msaa_depth);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, *depth);
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
     throw UserError(fmt::format("renderer: the {}x{} framebuffer with {} samples is not supported",
                                 W, H, samples));
-
-  color_target_(&e->resolve_fbo, &e->resolve_tex, GL_R8, nullptr, W, H);
-  // The reflection is blurred by the waves and the Fresnel mix anyway: half
-  // resolution costs a quarter of the fill for no visible loss. Its mip
-  // levels (made only when wind ripples blur it) are the rough-mirror blur.
-  const int RW = (W + 1) / 2, RH = (H + 1) / 2;
-  refl_levels = 1 + static_cast<int>(std::floor(std::log2(std::max(RW, RH))));
-  color_target_(&e->refl_fbo, &e->refl_tex, GL_R8, &e->refl_depth, RW, RH, refl_levels);
 }
 
 void StereoRenderer::upload(const SceneGeometry& scene) {
@@ -526,6 +545,9 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   glUniform2f(loc(water_prog, "u_focal"), static_cast<float>(rig.camera.fx),
               static_cast<float>(rig.camera.fy));
   glUniform1f(loc(water_prog, "u_refl_max_lod"), static_cast<float>(refl_levels - 1));
+  glUniform1f(loc(water_prog, "u_refl_texel_px"),
+              static_cast<float>(std::sqrt(double(rig.camera.width) * rig.camera.height /
+                                           (double(refl_width) * refl_height))));
   glUniform1i(loc(water_prog, "u_reflection"), 0);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, reflection);
@@ -599,13 +621,20 @@ void StereoRenderer::Impl::draw_eye(const SE3& T_W_C, double t, int eye_index) {
   glDisable(GL_CULL_FACE);
   if (reflect) {
     // The scene mirrored in the water plane, seen from the same camera.
-    glBindFramebuffer(GL_FRAMEBUFFER, e.refl_fbo);
-    glViewport(0, 0, (W + 1) / 2, (H + 1) / 2);
+    const int RW = refl_width, RH = refl_height;
+    const bool multisampled = options.reflection_msaa_samples > 1;
+    glBindFramebuffer(GL_FRAMEBUFFER, multisampled ? e.refl_msaa_fbo : e.refl_fbo);
+    glViewport(0, 0, RW, RH);
     glClearColor(scene.lighting.sky_brightness, 0, 0, 1);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_CLIP_DISTANCE0);
     draw_scene(view, eye, -1.f, 0);
     glDisable(GL_CLIP_DISTANCE0);
+    if (multisampled) {
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, e.refl_msaa_fbo);
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.refl_fbo);
+      glBlitFramebuffer(0, 0, RW, RH, 0, 0, RW, RH, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
     if (!ripple_phase.empty()) {
       glBindTexture(GL_TEXTURE_2D, e.refl_tex);
       glGenerateMipmap(GL_TEXTURE_2D);

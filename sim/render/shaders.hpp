@@ -204,6 +204,7 @@ uniform float u_time;
 uniform mat4 u_view;
 uniform vec2 u_focal;           // fx, fy [px]
 uniform float u_refl_max_lod;
+uniform float u_refl_texel_px;  // image pixels per texel of the reflection pass (geometric mean)
 uniform vec3 u_eye;
 uniform sampler2D u_reflection;
 uniform bool u_has_reflection;
@@ -264,9 +265,9 @@ void main() {
     float major = sqrt(half_tr + root), minor = sqrt(max(half_tr - root, 0.0));
     vec2 axis = abs(C[1][0]) > 1e-9 ? normalize(vec2(half_tr + root - C[1][1], C[1][0]))
                                     : (C[0][0] >= C[1][1] ? vec2(1.0, 0.0) : vec2(0.0, 1.0));
-    // A mip level of width w texels (2 w pixels) has a standard deviation
-    // of about w / 2.5 texels.
-    float lod = clamp(log2(max(1.25 * minor, 1.0)), 0.0, u_refl_max_lod);
+    // A mip level of width w texels (w u_refl_texel_px pixels) has a
+    // standard deviation of about w / 2.5 texels.
+    float lod = clamp(log2(max(2.5 * minor / u_refl_texel_px, 1.0)), 0.0, u_refl_max_lod);
     vec2 step = axis * (major / 0.866) / u_viewport;  // taps -2..2 at 0.75 step: sd 0.866
     const float w[5] = float[5](1.0, 2.0, 3.0, 2.0, 1.0);
     float sum = 0.0;

@@ -61,7 +61,8 @@ std::vector<MissionSegment> plan_mission(const MissionOptions& m, const Vec2& st
       // length is reached. The first lane is the one on the start's side of
       // the centre line; a start off it joins it along the first leg.
       const double offset = 0.25 * ctx.river_width_m;
-      const double leg = m.survey_leg_length_m > 0 ? m.survey_leg_length_m : ctx.survey_leg_length_m;
+      const double leg =
+          m.survey_leg_length_m > 0 ? m.survey_leg_length_m : ctx.survey_leg_length_m;
       const double side = start.y() > ctx.river_centre_east_m ? 1.0 : -1.0;
       Vec2 p = start;
       double lane = ctx.river_centre_east_m + side * offset;
