@@ -268,20 +268,20 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   }
 
   // Accuracy on frames from the real renderer, shipped defaults (the river paper's Bumblebee2
-  // camera, textures at contrast 2). Measured on 2026-11-25: sparse_kf e'_p 0.0156 m/m, length
-  // +0.2 %, 3D RMSE 0.77 % of the track; sparse (the paper's frame-to-frame method) 0.1425 m/m,
-  // length -13.4 %. The
-  // bounds sit 30 % above, so a 30 % regression of either VO or of the renderer fails; the
-  // length bound is the twin-fidelity issue's acceptance (+-3 %).
+  // camera, textures at contrast 2, the reflection pass at full resolution). Measured on
+  // 2026-11-25: sparse_kf e'_p 0.0112 m/m, length +0.1 %, 3D RMSE 0.58 % of the track; sparse
+  // (the paper's frame-to-frame method) 0.1097 m/m, length -10.3 %. The bounds sit 30 % above,
+  // so a 30 % regression of either VO or of the renderer fails; the length bound is the
+  // twin-fidelity issue's acceptance (+-3 %).
   auto mean_ep = [&](const char* algo) {
     return m["algorithms"][algo]["sections"]["p_m_per_m"]["mean"].get<double>();
   };
   const auto& kf = m["algorithms"]["sparse_kf"];
-  EXPECT_LT(mean_ep("sparse_kf"), 0.0205);
+  EXPECT_LT(mean_ep("sparse_kf"), 0.0146);
   EXPECT_GT(mean_ep("sparse_kf"), 0.0);
   EXPECT_LT(std::abs(kf["track"]["length_error_pct"].get<double>()), 3.0);
-  EXPECT_LT(kf["track"]["rmse_3d_pct"].get<double>(), 1.0);
-  EXPECT_LT(mean_ep("sparse"), 0.185);
+  EXPECT_LT(kf["track"]["rmse_3d_pct"].get<double>(), 0.75);
+  EXPECT_LT(mean_ep("sparse"), 0.143);
   EXPECT_GT(mean_ep("sparse"), 0.0);
   std::istringstream sections(slurp(out / "sections.csv"));
   std::getline(sections, header);
