@@ -27,6 +27,12 @@ double median(std::vector<double> v) {
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+// Frees a vector's storage (clear() keeps it).
+template <class T>
+void release(std::vector<T>* v) {
+  std::vector<T>().swap(*v);
+}
+
 }  // namespace
 
 struct SensorStage::Impl {
@@ -99,6 +105,14 @@ SensorData SensorStage::finish(const sim::SceneGeometry* scene) {
     s.imu_csv->commit();
     stats["imu"] = {{"samples", s.data.imu.size()}, {"rate_hz", s.sc.sensors.imu.rate_hz}};
   }
+  // What only the physics stage needed goes before the frame loop: the sample times run to the
+  // motion's hard limit (24 MB for the IMU at 200 Hz), and the IMU's samples, grown by
+  // doubling, may hold twice their size.
+  release(&s.imu_times);
+  release(&s.gps_times);
+  release(&s.compass_times);
+  release(&s.imu_biases);
+  s.data.imu.shrink_to_fit();
   if (s.sc.sensors.gps.enabled) {
     std::unique_ptr<scenes::MeshSkyObstruction> sky;
     if (scene != nullptr) sky = std::make_unique<scenes::MeshSkyObstruction>(*scene);
@@ -157,6 +171,8 @@ SensorData SensorStage::finish(const sim::SceneGeometry* scene) {
                         {"heading_rmse_deg", n > 0 ? std::sqrt(sq / n) * 180 / M_PI : 0.0},
                         {"heading_max_error_deg", worst * 180 / M_PI}};
   }
+  release(&s.gps_bodies);
+  release(&s.compass_bodies);
   return std::move(s.data);
 }
 

@@ -42,7 +42,8 @@ class SensorStage {
   /// The body at one of sample_times() (call each in time order).
   void on_sample(const sim::BodySample& b);
   /// The IMU's biases at time t_ns: those of the last IMU sample at or before it (the bias
-  /// walks once per sample), the first sample's before it; nullopt without an IMU or samples.
+  /// walks once per sample), the first sample's before it; nullopt without an IMU or samples,
+  /// and after finish() (which lets the history go).
   std::optional<ImuBias> imu_bias_at(TimeNs t_ns) const;
   /// Measures GPS and compass (scene: sky obstruction and steel anomalies; null: open sky, no
   /// scene anomalies), commits the CSVs and returns everything measured.
