@@ -97,8 +97,10 @@ StudyCommands::StudyCommands(CLI::App& app) {
                    "Merge the finished jobs even when some are not done");
   merge_->add_flag("--no-plots", no_plots_, "Do not run gnuplot");
   merge_->add_option("--regress", run_regressions_,
-                     "Run-level regression METRIC~AXIS[+AXIS...] (repeatable), e.g. "
-                     "basin_north_rmse_m~amplitude_m+wavelength_m");
+                     "Run-level regression METRIC~AXIS[+AXIS...][@AXIS=VALUE,...] "
+                     "(repeatable), e.g. basin_north_rmse_m~amplitude_m+wavelength_m; after @ "
+                     "only the runs with those parameter values, e.g. "
+                     "basin_north_rmse_m~amplitude_m@direction_deg=-40");
 
   schema_ =
       sweep_->add_subcommand("schema", "Print the reference of every sweep-file key (Markdown)");

@@ -734,7 +734,8 @@ OlsResult ols(const std::vector<double>& y, const std::vector<std::vector<double
 
 std::string OlsResult::brief() const {
   std::string s = fmt::format(
-      "OLS: {} sections, {} regressors{}, df_resid {}; R^2 {:.4f} (adjusted {:.4f}); F({}, {}) {} "
+      "OLS: {} observations, {} regressors{}, df_resid {}; R^2 {:.4f} (adjusted {:.4f}); F({}, {}) "
+      "{} "
       "(p {}{}); sigma {}.",
       n, df_model, intercept ? " + intercept" : " (no intercept)", df_resid, r2, adj_r2, df_model,
       df_resid, g4(f), p_text(f_p), f_p < alpha ? ", significant" : ", not significant", g4(sigma));

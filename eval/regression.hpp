@@ -88,7 +88,7 @@ struct OlsDiagnostics {
 /// Nothing in the result is ever NaN.
 struct OlsResult {
   std::vector<OlsCoefficient> coefficients;  ///< intercept first (if any), then columns in order
-  std::size_t n = 0;                         ///< observations (sections)
+  std::size_t n = 0;                         ///< observations (sections, or runs)
   std::size_t df_model = 0;                  ///< regressors, intercept excluded
   std::size_t df_resid = 0;                  ///< n - parameters
   bool intercept = true;                     ///< as in the options

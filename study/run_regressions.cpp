@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -24,6 +25,65 @@ double regression_metric_value(const nlohmann::json& metrics, const std::string&
   for (const auto& rm : run_metrics())
     if (rm.name == metric) return run_metric_value(metrics, algorithm, rm);
   return json_number(metrics, "algorithms." + algorithm + "." + metric);
+}
+
+// Whether a job's parameter text equals a condition's value: as text, or as numbers.
+bool same_value(const std::string& param, const std::string& value) {
+  if (param == value) return true;
+  char* end_p = nullptr;
+  char* end_v = nullptr;
+  const double p = std::strtod(param.c_str(), &end_p), v = std::strtod(value.c_str(), &end_v);
+  return !param.empty() && !value.empty() && *end_p == '\0' && *end_v == '\0' && p == v;
+}
+
+// Whether a job meets every condition of a --regress.
+bool meets(const SweepJob& job, const std::vector<std::pair<std::string, std::string>>& where) {
+  for (const auto& [axis, value] : where) {
+    bool ok = false;
+    for (const auto& [name, param] : job.params)
+      ok = ok || (name == axis && same_value(param, value));
+    if (!ok) return false;
+  }
+  return true;
+}
+
+// The AXIS=VALUE conditions after '@', each checked against the sweep's axes and jobs.
+std::vector<std::pair<std::string, std::string>> parse_conditions(const std::string& spec,
+                                                                  const std::string& text,
+                                                                  const SweepManifest& m) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (std::size_t start = 0; start <= text.size();) {
+    const auto comma = text.find(',', start);
+    const std::string c = text.substr(start, comma == std::string::npos ? comma : comma - start);
+    const auto eq = c.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == c.size())
+      throw UserError(
+          fmt::format("--regress '{}': got condition '{}', expected AXIS=VALUE", spec, c));
+    const std::string axis = c.substr(0, eq), value = c.substr(eq + 1);
+    std::vector<std::string> names, values;
+    for (const auto& ax : m.axes) names.push_back(ax.name);
+    if (std::find(names.begin(), names.end(), axis) == names.end())
+      throw UserError(
+          fmt::format("--regress '{}': got condition axis '{}', expected an axis of "
+                      "the sweep: {}",
+                      spec, axis, fmt::join(names, ", ")));
+    bool found = false;
+    for (const auto& job : m.jobs)
+      for (const auto& [name, param] : job.params) {
+        if (name != axis) continue;
+        found = found || same_value(param, value);
+        if (std::find(values.begin(), values.end(), param) == values.end()) values.push_back(param);
+      }
+    if (!found)
+      throw UserError(
+          fmt::format("--regress '{}': got {} = {}, expected one of the axis's "
+                      "values: {}",
+                      spec, axis, value, fmt::join(values, ", ")));
+    out.emplace_back(axis, value);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
 }
 
 }  // namespace
@@ -73,15 +133,18 @@ std::vector<RunRegression> parse_run_regressions(const std::vector<std::string>&
                                                  const SweepManifest& m) {
   std::vector<RunRegression> out;
   for (const auto& spec : specs) {
-    RunRegression r{spec, "", {}};
-    const auto tilde = spec.find('~');
-    if (tilde == std::string::npos || tilde == 0 || tilde + 1 == spec.size())
+    RunRegression r{spec, "", {}, {}};
+    const auto at = spec.find('@');
+    const std::string formula = spec.substr(0, at);
+    const auto tilde = formula.find('~');
+    if (tilde == std::string::npos || tilde == 0 || tilde + 1 == formula.size())
       throw UserError(
-          fmt::format("--regress: got '{}', expected METRIC~AXIS[+AXIS...], e.g. "
-                      "basin_north_rmse_m~amplitude_m",
+          fmt::format("--regress: got '{}', expected METRIC~AXIS[+AXIS...][@AXIS=VALUE,...], "
+                      "e.g. basin_north_rmse_m~amplitude_m@direction_deg=-40",
                       spec));
-    r.metric = spec.substr(0, tilde);
-    std::string rest = spec.substr(tilde + 1);
+    if (at != std::string::npos) r.where = parse_conditions(spec, spec.substr(at + 1), m);
+    r.metric = formula.substr(0, tilde);
+    std::string rest = formula.substr(tilde + 1);
     for (std::size_t start = 0; start <= rest.size();) {
       const auto plus = rest.find('+', start);
       r.axes.push_back(rest.substr(start, plus == std::string::npos ? plus : plus - start));
@@ -113,6 +176,7 @@ void run_regressions(const std::vector<RunRegression>& specs, const std::vector<
     std::vector<double> y;
     std::vector<std::vector<double>> columns(spec.axes.size());
     for (const auto& r : runs) {
+      if (!meets(*r.job, spec.where)) continue;
       const double v = regression_metric_value(r.metrics, algorithm, spec.metric);
       std::vector<double> x;
       for (const auto& axis : spec.axes)
@@ -123,8 +187,12 @@ void run_regressions(const std::vector<RunRegression>& specs, const std::vector<
       for (std::size_t k = 0; k < x.size(); ++k) columns[k].push_back(x[k]);
     }
     nlohmann::ordered_json jr;
-    *md += fmt::format("\nRegression of `{}` on `{}` over the runs:\n\n", spec.metric,
-                       fmt::join(spec.axes, "`, `"));
+    std::vector<std::string> conditions;
+    for (const auto& [axis, value] : spec.where) conditions.push_back(axis + " = " + value);
+    *md += fmt::format(
+        "\nRegression of `{}` on `{}` over the runs{}:\n\n", spec.metric,
+        fmt::join(spec.axes, "`, `"),
+        conditions.empty() ? "" : " with " + fmt::format("{}", fmt::join(conditions, ", ")));
     try {
       if (y.size() < spec.axes.size() + 2)
         throw UserError(fmt::format("got {} runs with a value, need at least {}", y.size(),

@@ -1,6 +1,7 @@
-// Regressions over the runs of a sweep (`sweep merge --regress METRIC~AXIS[+AXIS...]`): a run
-// metric of each algorithm on swept axes, by OLS (river paper Eq. (13) in form), and the OLS
-// block that these and the pooled section regression write into metrics.json and summary.md.
+// Regressions over the runs of a sweep (`sweep merge --regress
+// METRIC~AXIS[+AXIS...][@AXIS=VALUE,...]`): a run metric of each algorithm on swept axes, over
+// all runs or those with the given parameter values, by OLS (river paper Eq. (13) in form), and the
+// OLS block that these and the pooled section regression write into metrics.json and summary.md.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -19,13 +20,16 @@ struct RunData {
 };
 
 /// One --regress: a run metric (its runs.csv name, or a key path under algorithms.ALGO) on
-/// swept axes.
+/// swept axes, over the runs whose parameters meet every condition (AXIS=VALUE after '@').
 struct RunRegression {
   std::string text, metric;
   std::vector<std::string> axes;
+  std::vector<std::pair<std::string, std::string>> where;
 };
 
-/// Checks each METRIC~AXIS[+AXIS...] against the sweep's numeric axes.
+/// Checks each METRIC~AXIS[+AXIS...][@AXIS=VALUE[,AXIS=VALUE...]] against the sweep: the
+/// regressors must be numeric axes; a condition's axis must be an axis of the sweep and its
+/// value one that some job has (numbers compare by value: -40 matches -40.0).
 std::vector<RunRegression> parse_run_regressions(const std::vector<std::string>& specs,
                                                  const SweepManifest& m);
 

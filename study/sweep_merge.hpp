@@ -31,9 +31,10 @@ struct MergeOptions {
   std::vector<std::string> covariates;
   /// The regression's response: a column of the pooled table.
   std::string response = "p_m_per_m";
-  /// Run-level regressions, "METRIC~AXIS[+AXIS...]": a run metric (a runs.csv column such
-  /// as basin_north_rmse_m, or a key path under algorithms.ALGO of a run's metrics.json) on
-  /// swept axes, by OLS over the runs of each algorithm (metrics.json run_regressions).
+  /// Run-level regressions, "METRIC~AXIS[+AXIS...][@AXIS=VALUE,...]": a run metric (a
+  /// runs.csv column such as basin_north_rmse_m, or a key path under algorithms.ALGO of a run's
+  /// metrics.json) on swept axes, by OLS over the runs of each algorithm (metrics.json
+  /// run_regressions); after '@', only over the runs with those parameter values.
   std::vector<std::string> run_regressions;
   /// Merge the finished jobs even when some are not done.
   bool allow_missing = false;

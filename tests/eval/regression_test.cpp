@@ -611,7 +611,7 @@ TEST(OlsSummaryTest, PaperShapedFitAndBrief) {
   EXPECT_NEAR(dot_h, 0.0, 1e-12);
   const std::string brief = r.brief();
   for (const std::string part :
-       {"96 sections", "R^2", "F(4, 91)", "Intercept", "h ", "*", "Jarque-Bera", "Shapiro-Wilk",
+       {"96 observations", "R^2", "F(4, 91)", "Intercept", "h ", "*", "Jarque-Bera", "Shapiro-Wilk",
         "Breusch-Pagan", "Durbin-Watson", "max VIF"})
     EXPECT_NE(brief.find(part), std::string::npos) << "'" << part << "' not in: " << brief;
   expect_no_nan(r);

@@ -27,6 +27,7 @@
 #include "core/yaml_io.hpp"
 #include "gate/gate.hpp"
 #include "pipeline/scenario.hpp"
+#include "study/run_regressions.hpp"
 #include "study/sweep_merge.hpp"
 #include "study/sweep_runner.hpp"
 #include "tests/support/test_support.hpp"
@@ -748,6 +749,67 @@ TEST(SweepCli, MergeRegressesAnyRunMetricOnTheAxes) {
                 .find("Regression of `ape_trans_rmse_m` on `yaw_amp_deg` over the runs"),
             std::string::npos);
   fs::remove_all(dir);
+}
+
+TEST(RunRegressions, AConditionFitsOnlyTheRunsWithThatValue) {
+  // Six hand-made runs on a zip of amplitude and direction: north RMSE = 2 a + 0.01 from
+  // -40 deg, 0.5 a + 0.02 from 0 deg (exact lines), so each direction's slope is known.
+  SweepManifest m;
+  m.axes = {{"water.waves.airy.amplitude_m", "amplitude_m", "values", true},
+            {"water.waves.airy.direction_deg", "direction_deg", "values", true}};
+  const double amplitude[] = {0.005, 0.0075, 0.011, 0.005, 0.0075, 0.011};
+  const char* amplitude_text[] = {"0.005", "0.0075", "0.011", "0.005", "0.0075", "0.011"};
+  for (int k = 0; k < 6; ++k) {
+    SweepJob job;
+    job.id = "p000" + std::to_string(k) + "-r00";
+    job.params = {{"amplitude_m", amplitude_text[k]}, {"direction_deg", k < 3 ? "-40" : "0"}};
+    m.jobs.push_back(job);
+  }
+  std::vector<RunData> runs;
+  for (int k = 0; k < 6; ++k) {
+    const double north = k < 3 ? 2.0 * amplitude[k] + 0.01 : 0.5 * amplitude[k] + 0.02;
+    nlohmann::json metrics;
+    metrics["algorithms"]["pnp"]["basin"]["north_m"]["rmse"] = north;
+    runs.push_back({&m.jobs[static_cast<std::size_t>(k)], metrics});
+  }
+  const auto specs =
+      parse_run_regressions({"basin_north_rmse_m~amplitude_m@direction_deg=-40.0",
+                             "basin_north_rmse_m~amplitude_m@direction_deg=0,amplitude_m=0.005",
+                             "basin_north_rmse_m~amplitude_m"},
+                            m);
+  ASSERT_EQ(specs.size(), 3u);
+  ASSERT_EQ(specs[0].where.size(), 1u);
+  nlohmann::ordered_json j;
+  std::string md;
+  std::vector<std::string> warnings;
+  run_regressions(specs, runs, "pnp", &j, &md, &warnings);
+  const auto& within = j["basin_north_rmse_m~amplitude_m@direction_deg=-40.0"];
+  EXPECT_EQ(within["n"], 3);
+  EXPECT_NEAR(within["coefficients"]["amplitude_m"]["estimate"].get<double>(), 2.0, 1e-9);
+  EXPECT_NEAR(within["coefficients"]["Intercept"]["estimate"].get<double>(), 0.01, 1e-11);
+  EXPECT_NE(md.find("over the runs with direction_deg = -40.0:"), std::string::npos) << md;
+  // One run meets both conditions: too few to fit, recorded and warned, not thrown.
+  EXPECT_TRUE(
+      j["basin_north_rmse_m~amplitude_m@direction_deg=0,amplitude_m=0.005"].contains("skipped"));
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("got 1 runs with a value"), std::string::npos) << warnings[0];
+  EXPECT_EQ(j["basin_north_rmse_m~amplitude_m"]["n"], 6);
+
+  auto refused = [&](const std::string& spec, const std::string& expected) {
+    try {
+      parse_run_regressions({spec}, m);
+      ADD_FAILURE() << spec << " was accepted";
+    } catch (const UserError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused("basin_north_rmse_m~amplitude_m@direction_deg=40",
+          "got direction_deg = 40, expected one of the axis's values: -40, 0");
+  refused("basin_north_rmse_m~amplitude_m@heading_deg=0",
+          "got condition axis 'heading_deg', expected an axis of the sweep: amplitude_m, "
+          "direction_deg");
+  refused("basin_north_rmse_m~amplitude_m@direction_deg", "expected AXIS=VALUE");
+  refused("basin_north_rmse_m@direction_deg=0", "expected METRIC~AXIS[+AXIS...]");
 }
 
 TEST(SweepCli, BuiltInAndExternalVoSideBySideMergeIntoOneTable) {
