@@ -96,6 +96,13 @@ sim::Material material(int texture, float albedo, float specular = 0.0f) {
   return m;
 }
 
+// The material of a surface that bounds a solid: its back faces are never seen.
+sim::Material solid(int texture, float albedo) {
+  sim::Material m = material(texture, albedo);
+  m.double_sided = false;
+  return m;
+}
+
 struct Textures {
   int grass, soil, bark, foliage, reeds, concrete, sheet, facade, roof, brick, stone;
 };
@@ -141,7 +148,7 @@ void add_terrain(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k,
   const Vec3 front(0, -0.5 * side, -1);  // up and towards the river
   auto grid = [&](const std::vector<double>& cols, const char* what, int texture, float albedo,
                   double repeat_m) {
-    MeshBuilder mb(tile_name(L.index, what), material(texture, albedo));
+    MeshBuilder mb(tile_name(L.index, what), solid(texture, albedo));
     const int nc = static_cast<int>(cols.size());
     std::vector<Vec3> P(static_cast<std::size_t>((rows + 1) * nc));
     auto at = [&](int r, int c) -> Vec3& { return P[static_cast<std::size_t>(r * nc + c)]; };
@@ -392,9 +399,9 @@ void add_buildings(sim::SceneGeometry* g, const RiverTileLayout& L, const Textur
 void add_far_field(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k, const Noise& n,
                    const Textures& tex, int side) {
   MeshBuilder wood(tile_name(L.index, side > 0 ? "far_wood_east" : "far_wood_west"),
-                   material(tex.foliage, 0.7f));
+                   solid(tex.foliage, 0.7f));
   MeshBuilder hills(tile_name(L.index, side > 0 ? "far_hills_east" : "far_hills_west"),
-                    material(tex.foliage, 0.55f));
+                    solid(tex.foliage, 0.55f));
   const int segs = std::max(1, static_cast<int>(std::ceil((L.x1_m - L.x0_m) / 5.0)));
   const double s_edge = kFarFieldStart_m + 2.0;
   const Vec3 towards_river(0, -side, 0);
@@ -431,8 +438,7 @@ void add_far_field(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& 
 // faces north, -1: faces south); its skyline follows the side's far field.
 void add_river_bend(sim::SceneGeometry* g, double x_end, int facing, const Bank& k, const Noise& n,
                     const Textures& tex) {
-  MeshBuilder mb(facing < 0 ? "river_bend_north" : "river_bend_south",
-                 material(tex.foliage, 0.65f));
+  MeshBuilder mb(facing < 0 ? "river_bend_north" : "river_bend_south", solid(tex.foliage, 0.65f));
   const double half = k.b + kFarFieldEnd_m;
   const int segs = static_cast<int>(std::ceil(2 * half / 5.0));
   const Vec3 front(facing, 0, 0);
@@ -679,8 +685,8 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
     const RiverTileLayout L = plan_river_tile(options, seed, index);
     for (int side : {1, -1}) add_terrain(&g, L, k, n, tex, side);
 
-    MeshBuilder trunks(tile_name(index, "tree_trunks"), material(tex.bark, 0.7f));
-    MeshBuilder crowns(tile_name(index, "tree_crowns"), material(tex.foliage, 0.8f));
+    MeshBuilder trunks(tile_name(index, "tree_trunks"), solid(tex.bark, 0.7f));
+    MeshBuilder crowns(tile_name(index, "tree_crowns"), solid(tex.foliage, 0.8f));
     Rng lumps = RngStreams(seed).stream("scene.river.tile." + std::to_string(index) + ".crowns");
     for (const TreeSpec& t : L.trees) {
       const double z_crown_centre = t.base_W.z() - (1.0 - kCrownAxisFrac) * t.height_m;
@@ -690,7 +696,7 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
     }
     add_mesh(&g, trunks.take());
     add_mesh(&g, crowns.take());
-    MeshBuilder bushes(tile_name(index, "bushes"), material(tex.foliage, 0.8f));
+    MeshBuilder bushes(tile_name(index, "bushes"), solid(tex.foliage, 0.8f));
     for (const TreeSpec& t : L.bushes) add_crown(&bushes, t, 0.5, &lumps);
     add_mesh(&g, bushes.take());
 

@@ -32,6 +32,12 @@ struct Material {
   int texture = -1;       // index into SceneGeometry::textures, -1 = none (white)
   float albedo = 0.6f;    // multiplies the texture [0, 1]
   float specular = 0.0f;  // strength of a sun glint on this surface [0, 1]
+  // false: the surface is seen only from the side its normals point to (it bounds a solid: a
+  // closed crown or trunk, or terrain over the ground), so the renderer skips its back faces
+  // (as glTF's doubleSided). Its triangles must be wound counter-clockwise about their normals
+  // ((b - a) x (c - a) along the normal), as MeshBuilder's are. true: open sheets seen from both
+  // sides (reed blades, sheet piling, roofs seen from below).
+  bool double_sided = true;
 };
 
 struct Mesh {

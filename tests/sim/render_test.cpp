@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -308,6 +309,85 @@ TEST(Render, SubPixelMotionOfOutlinesAndReflectionsKeepsItsSize) {
       "[ measured ] largest sub-pixel shift error [px]: disc %.3f, mirror %.3f (shipped), "
       "%.3f (half resolution), %.3f (half resolution, 4x MSAA)\n",
       shipped.direct_px, shipped.mirror_px, half_mirror, half_msaa_mirror);
+}
+
+// A planar quad (corners in order around its edge) with normal n, wound counter-clockwise
+// about n as Material::double_sided = false requires; textured so that it is not flat grey.
+Mesh quad_mesh(const std::array<Vec3, 4>& p, const Vec3& n, bool double_sided) {
+  Mesh m;
+  m.name = "quad";
+  m.material.albedo = 0.9f;
+  m.material.double_sided = double_sided;
+  for (const Vec3& q : p)
+    m.vertices.push_back(Vertex{static_cast<float>(q.x()), static_cast<float>(q.y()),
+                                static_cast<float>(q.z()), static_cast<float>(n.x()),
+                                static_cast<float>(n.y()), static_cast<float>(n.z()), 0.f, 0.f});
+  const bool ccw = (p[1] - p[0]).cross(p[2] - p[0]).dot(n) > 0;
+  for (std::uint32_t i : ccw ? std::array<std::uint32_t, 6>{0, 1, 2, 0, 2, 3}
+                             : std::array<std::uint32_t, 6>{0, 2, 1, 0, 3, 2})
+    m.indices.push_back(i);
+  return m;
+}
+
+// A closed box [lo, hi], each face wound counter-clockwise about its outward normal.
+std::vector<Mesh> box_meshes(const Vec3& lo, const Vec3& hi, bool double_sided) {
+  std::vector<Mesh> faces;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side : {-1, 1}) {
+      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+      std::array<Vec3, 4> p;
+      for (int k = 0; k < 4; ++k) {
+        Vec3 q;
+        q[axis] = side < 0 ? lo[axis] : hi[axis];
+        q[a] = (k == 1 || k == 2) ? hi[a] : lo[a];
+        q[b] = (k >= 2) ? hi[b] : lo[b];
+        p[static_cast<std::size_t>(k)] = q;
+      }
+      faces.push_back(quad_mesh(p, side * Vec3::Unit(axis), double_sided));
+    }
+  return faces;
+}
+
+int differing_pixels(const GrayImage& a, const GrayImage& b) {
+  int n = 0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) n += a.pixels[i] != b.pixels[i];
+  return n;
+}
+
+TEST(Render, OneSidedMeshesSkipOnlyTheirBackFaces) {
+  // Over calm water, in the default light: each scene's left and right images, mirror images
+  // included, with the meshes one-sided and two-sided.
+  auto render = [](const std::vector<Mesh>& meshes) {
+    SceneGeometry s;
+    s.water.enabled = true;
+    s.meshes = meshes;
+    StereoRenderer renderer(rig_640(), RenderOptions{});
+    renderer.upload(s);
+    renderer.set_waves({});
+    return renderer.render(camera_at(Vec3(0, 0.3, -0.8)), 0.0, false);
+  };
+  const StereoImages empty = render({});
+  // A closed box, 1 m, 8 m ahead: the same images either way (its far faces are hidden).
+  const Vec3 lo(8, -0.5, -2.0), hi(9, 0.5, -1.0);
+  const StereoImages box2 = render(box_meshes(lo, hi, true)),
+                     box1 = render(box_meshes(lo, hi, false));
+  EXPECT_GT(differing_pixels(box2.left, empty.left), 5000);
+  EXPECT_EQ(differing_pixels(box1.left, box2.left), 0);
+  EXPECT_EQ(differing_pixels(box1.right, box2.right), 0);
+  // A sheet 2 m x 1.5 m across the view: facing the camera (normal south) it shows, with its
+  // mirror image, the same one-sided or two-sided; facing away a one-sided one is not drawn.
+  const std::array<Vec3, 4> sheet{Vec3(6, -1, -2), Vec3(6, 1, -2), Vec3(6, 1, -0.5),
+                                  Vec3(6, -1, -0.5)};
+  const StereoImages front1 = render({quad_mesh(sheet, -Vec3::UnitX(), false)});
+  const StereoImages front2 = render({quad_mesh(sheet, -Vec3::UnitX(), true)});
+  EXPECT_GT(differing_pixels(front2.left, empty.left), 20000);
+  EXPECT_EQ(differing_pixels(front1.left, front2.left), 0);
+  EXPECT_EQ(differing_pixels(front1.right, front2.right), 0);
+  const StereoImages away1 = render({quad_mesh(sheet, Vec3::UnitX(), false)});
+  const StereoImages away2 = render({quad_mesh(sheet, Vec3::UnitX(), true)});
+  EXPECT_GT(differing_pixels(away2.left, empty.left), 20000);
+  EXPECT_EQ(differing_pixels(away1.left, empty.left), 0);
+  EXPECT_EQ(differing_pixels(away1.right, empty.right), 0);
 }
 
 TEST(Render, BadRigIsAClearError) {
