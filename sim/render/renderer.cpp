@@ -496,10 +496,10 @@ void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::
   std::sort(draw_order.begin(), draw_order.end());
   // Back faces of one-sided meshes are skipped: a CPU rasteriser pays for every pixel a triangle
   // covers, also those the depth test rejects (in the river reach the tree crowns were 4 in 10
-  // of the scene's covered pixels, and 1 in 25 of theirs was drawn). The
-  // optical frame's y points down and the projection keeps it, so the image is flipped in GL's
-  // window coordinates: a face wound counter-clockwise about its normal is clockwise on screen;
-  // the mirror image flips the winding once more.
+  // of the scene's covered pixels, and 1 in 25 of theirs was drawn). The optical frame's y points
+  // down and the projection keeps it, so the image is flipped in GL's window coordinates: a face
+  // wound counter-clockwise about its normal is clockwise on screen; the mirror image flips the
+  // winding once more.
   glFrontFace(mirror > 0.f ? GL_CW : GL_CCW);
   for (const auto& [distance, index] : draw_order) {
     const GpuMesh& g = meshes[index];
