@@ -27,6 +27,17 @@ double regression_metric_value(const nlohmann::json& metrics, const std::string&
   return json_number(metrics, "algorithms." + algorithm + "." + metric);
 }
 
+// The pieces of `text` between the separators (empty pieces kept).
+std::vector<std::string> split(const std::string& text, char separator) {
+  std::vector<std::string> out;
+  for (std::size_t start = 0;;) {
+    const auto at = text.find(separator, start);
+    out.push_back(text.substr(start, at == std::string::npos ? at : at - start));
+    if (at == std::string::npos) return out;
+    start = at + 1;
+  }
+}
+
 // Whether a job's parameter text equals a condition's value: as text, or as numbers.
 bool same_value(const std::string& param, const std::string& value) {
   if (param == value) return true;
@@ -52,9 +63,7 @@ std::vector<std::pair<std::string, std::string>> parse_conditions(const std::str
                                                                   const std::string& text,
                                                                   const SweepManifest& m) {
   std::vector<std::pair<std::string, std::string>> out;
-  for (std::size_t start = 0; start <= text.size();) {
-    const auto comma = text.find(',', start);
-    const std::string c = text.substr(start, comma == std::string::npos ? comma : comma - start);
+  for (const std::string& c : split(text, ',')) {
     const auto eq = c.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == c.size())
       throw UserError(
@@ -80,8 +89,6 @@ std::vector<std::pair<std::string, std::string>> parse_conditions(const std::str
                       "values: {}",
                       spec, axis, value, fmt::join(values, ", ")));
     out.emplace_back(axis, value);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
   }
   return out;
 }
@@ -144,13 +151,7 @@ std::vector<RunRegression> parse_run_regressions(const std::vector<std::string>&
                       spec));
     if (at != std::string::npos) r.where = parse_conditions(spec, spec.substr(at + 1), m);
     r.metric = formula.substr(0, tilde);
-    std::string rest = formula.substr(tilde + 1);
-    for (std::size_t start = 0; start <= rest.size();) {
-      const auto plus = rest.find('+', start);
-      r.axes.push_back(rest.substr(start, plus == std::string::npos ? plus : plus - start));
-      if (plus == std::string::npos) break;
-      start = plus + 1;
-    }
+    r.axes = split(formula.substr(tilde + 1), '+');
     for (const auto& a : r.axes) {
       bool known = false;
       std::string names;
@@ -187,12 +188,11 @@ void run_regressions(const std::vector<RunRegression>& specs, const std::vector<
       for (std::size_t k = 0; k < x.size(); ++k) columns[k].push_back(x[k]);
     }
     nlohmann::ordered_json jr;
-    std::vector<std::string> conditions;
-    for (const auto& [axis, value] : spec.where) conditions.push_back(axis + " = " + value);
-    *md += fmt::format(
-        "\nRegression of `{}` on `{}` over the runs{}:\n\n", spec.metric,
-        fmt::join(spec.axes, "`, `"),
-        conditions.empty() ? "" : " with " + fmt::format("{}", fmt::join(conditions, ", ")));
+    std::string subset;
+    for (const auto& [axis, value] : spec.where)
+      subset += (subset.empty() ? " with " : ", ") + axis + " = " + value;
+    *md += fmt::format("\nRegression of `{}` on `{}` over the runs{}:\n\n", spec.metric,
+                       fmt::join(spec.axes, "`, `"), subset);
     try {
       if (y.size() < spec.axes.size() + 2)
         throw UserError(fmt::format("got {} runs with a value, need at least {}", y.size(),
