@@ -1,5 +1,6 @@
 #include "scenes/noise.hpp"
 
+#include <array>
 #include <cmath>
 
 namespace driftlab::scenes {
@@ -21,6 +22,16 @@ std::int64_t wrap(std::int64_t i, int period) {
   if (period <= 0) return i;
   const std::int64_t m = i % period;
   return m < 0 ? m + period : m;
+}
+
+// Lattice indices i + k for k = 0 .. N-1, wrapped like wrap(): one division for all N (they
+// dominate the cost of a texture without it).
+template <int N>
+std::array<std::int64_t, N> wrap_run(std::int64_t i, int period) {
+  std::array<std::int64_t, N> w;
+  w[0] = wrap(i, period);
+  for (int k = 1; k < N; ++k) w[k] = period > 0 && w[k - 1] + 1 == period ? 0 : w[k - 1] + 1;
+  return w;
 }
 
 // Quintic fade (Perlin 2002): continuous second derivative, so shading of
@@ -52,14 +63,15 @@ double Noise::gradient(double x, double y, int px, int py, std::uint64_t salt) c
   const double fx = std::floor(x), fy = std::floor(y);
   const double tx = x - fx, ty = y - fy;
   const auto ix = static_cast<std::int64_t>(fx), iy = static_cast<std::int64_t>(fy);
-  auto corner = [&](std::int64_t cx, std::int64_t cy, double dx, double dy) {
-    const std::uint64_t g = hash(wrap(cx, px), wrap(cy, py), salt) >> 61;  // 0..7
+  const auto wx = wrap_run<2>(ix, px), wy = wrap_run<2>(iy, py);
+  auto corner = [&](int i, int j, double dx, double dy) {
+    const std::uint64_t g = hash(wx[i], wy[j], salt) >> 61;  // 0..7
     return kGradX[g] * dx + kGradY[g] * dy;
   };
-  const double n00 = corner(ix, iy, tx, ty);
-  const double n10 = corner(ix + 1, iy, tx - 1.0, ty);
-  const double n01 = corner(ix, iy + 1, tx, ty - 1.0);
-  const double n11 = corner(ix + 1, iy + 1, tx - 1.0, ty - 1.0);
+  const double n00 = corner(0, 0, tx, ty);
+  const double n10 = corner(1, 0, tx - 1.0, ty);
+  const double n01 = corner(0, 1, tx, ty - 1.0);
+  const double n11 = corner(1, 1, tx - 1.0, ty - 1.0);
   const double sx = fade(tx), sy = fade(ty);
   // 2D gradient noise peaks near +-0.7; scale to about +-1.
   return 1.4 * lerp(lerp(n00, n10, sx), lerp(n01, n11, sx), sy);
@@ -69,12 +81,10 @@ double Noise::value(double x, double y, int px, int py, std::uint64_t salt) cons
   const double fx = std::floor(x), fy = std::floor(y);
   const double tx = x - fx, ty = y - fy;
   const auto ix = static_cast<std::int64_t>(fx), iy = static_cast<std::int64_t>(fy);
-  auto corner = [&](std::int64_t cx, std::int64_t cy) {
-    return 2.0 * unit(hash(wrap(cx, px), wrap(cy, py), salt)) - 1.0;
-  };
+  const auto wx = wrap_run<2>(ix, px), wy = wrap_run<2>(iy, py);
+  auto corner = [&](int i, int j) { return 2.0 * unit(hash(wx[i], wy[j], salt)) - 1.0; };
   const double sx = fade(tx), sy = fade(ty);
-  return lerp(lerp(corner(ix, iy), corner(ix + 1, iy), sx),
-              lerp(corner(ix, iy + 1), corner(ix + 1, iy + 1), sx), sy);
+  return lerp(lerp(corner(0, 0), corner(1, 0), sx), lerp(corner(0, 1), corner(1, 1), sx), sy);
 }
 
 double Noise::fbm(double u, double v, int px0, int py0, int octaves, double gain,
@@ -109,10 +119,11 @@ Noise::Cell Noise::worley(double x, double y, int px, int py, std::uint64_t salt
   const auto ix = static_cast<std::int64_t>(fx), iy = static_cast<std::int64_t>(fy);
   Cell c{1e9, 1e9, 0};
   double d1 = 1e18, d2 = 1e18;  // squared distances; one sqrt each at the end
+  const auto wx = wrap_run<3>(ix - 1, px), wy = wrap_run<3>(iy - 1, py);
   for (int dy = -1; dy <= 1; ++dy) {
     for (int dx = -1; dx <= 1; ++dx) {
       const std::int64_t cx = ix + dx, cy = iy + dy;
-      const std::uint64_t h = hash(wrap(cx, px), wrap(cy, py), salt);
+      const std::uint64_t h = hash(wx[dx + 1], wy[dy + 1], salt);
       // Feature point position inside the cell from two independent hash bit fields.
       const double ox = static_cast<double>(h & 0xffffffULL) * 0x1.0p-24;
       const double oy = static_cast<double>((h >> 24) & 0xffffffULL) * 0x1.0p-24;
