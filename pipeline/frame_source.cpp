@@ -47,6 +47,7 @@ struct Renderer {
     const Stopwatch watch;
     f.exposure_ms = camera->exposure_ms();  // this frame's (auto exposure)
     f.images = camera->capture(truth);
+    f.blur_samples = camera->last_blur_samples();
     if (depth)  // ground truth: the ideal pinhole depth at the centre of the exposure
       f.images.depth_left = renderer.render(camera->T_W_C(truth), truth.t_s, true).depth_left;
     f.render_ms = watch.ms();

@@ -26,6 +26,7 @@ struct CapturedFrame {
   sim::StereoImages images;  ///< what the camera delivers (rectified, 8-bit)
   double render_ms = 0;      ///< wall-clock time of rendering and camera effects
   double exposure_ms = 0;    ///< the exposure this frame was taken with
+  int blur_samples = 1;      ///< renders averaged for its motion blur (CameraStage::blur_samples)
 };
 
 /// What the renderer reports once it has run.

@@ -322,7 +322,7 @@ double run_frame_loop(FrameSource& source, const std::vector<sim::SampleTime>& s
   const Trajectory& camera_gt = mission.camera_gt;
   const std::vector<EulerZYX>& platform = mission.platform;
   AtomicFile frames_csv(dir / "frames.csv");
-  std::string header = "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms,exposure_ms";
+  std::string header = "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms,exposure_ms,blur_samples";
   for (const Track& tr : tracks)
     if (tr.vo) header += vo_csv_header(tr.name);
   frames_csv.write(header + "\n");
@@ -342,9 +342,10 @@ double run_frame_loop(FrameSource& source, const std::vector<sim::SampleTime>& s
     frame.t_ns = t;
     frame.left = cv_view(img.left);
     frame.right = cv_view(img.right);
-    std::string row = fmt::format("{},{},{},{},{:.3f},{}", t, rad2deg(platform[k].yaw_rad),
-                                  rad2deg(platform[k].pitch_rad), rad2deg(platform[k].roll_rad),
-                                  render_ms, yaml::format_double(exposure_ms));
+    std::string row =
+        fmt::format("{},{},{},{},{:.3f},{},{}", t, rad2deg(platform[k].yaw_rad),
+                    rad2deg(platform[k].pitch_rad), rad2deg(platform[k].roll_rad), render_ms,
+                    yaml::format_double(exposure_ms), captured->blur_samples);
     const std::vector<vo::VoResult> vo_results = process_vos(&tracks, frame, threads);
     for (std::size_t i = 0; i < tracks.size(); ++i) {
       Track& tr = tracks[i];
@@ -399,6 +400,7 @@ nlohmann::json camera_metrics(const Scenario& sc, std::size_t frames, std::size_
           {"noise", cam.noise.enabled},
           {"vignetting_strength", cam.vignetting_strength},
           {"motion_blur_samples", sc.render.motion_blur_samples},
+          {"motion_blur_step_px", sc.render.motion_blur_step_px},
           {"lens_distortion", cam.lens_distortion.enabled},
           {"clock_offset_ms", cam.clock.offset_ms}};
 }

@@ -29,6 +29,7 @@ struct RenderOptions {
   bool ground_truth_depth = false;
   bool reflections = true;
   int motion_blur_samples = 1;
+  double motion_blur_step_px = 0;
 
   template <class A>
   void visit(A& a) {
@@ -50,6 +51,12 @@ struct RenderOptions {
       "Motion blur: renders averaged over the exposure (sensors.camera.exposure_ms) along the "
       "true motion; 1 = off, each sample costs one more render",
       yaml::in_range(1, 64));
+    a("motion_blur_step_px", motion_blur_step_px,
+      "With motion_blur_samples > 1: the farthest the image may move between two samples; each "
+      "frame then takes as few samples as its rotation over the exposure needs (at least 1, at "
+      "most motion_blur_samples), so only the turns pay for blur. 0 = every frame takes "
+      "motion_blur_samples [px]",
+      yaml::at_least(0));
   }
 };
 

@@ -92,6 +92,53 @@ TEST(CameraStage, NoiseVarianceOnARenderedFrameMatchesTheModel) {
   EXPECT_LT(std::abs(cross / a.left.pixels.size()), 0.05 * expected / count);
 }
 
+// The largest image motion over the exposure of a turn about body down, found by brute force:
+// every 8th pixel's ray turned by the sub-frame poses' relative rotation and projected again.
+double largest_turn_motion_px(const Scenario& sc, double yaw_rate, double exposure_s) {
+  const PinholeCamera cam = rig_of(sc.sensors.camera).camera;
+  const SE3 T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
+  const SE3 start = frame(yaw_rate).T_W_B * T_B_C;
+  const SE3 turn(quat_from_euler_zyx({0.0, 0.0, yaw_rate * exposure_s}), Vec3::Zero());
+  const SE3 end = frame(yaw_rate).T_W_B * turn * T_B_C;
+  const Mat3 R_end_start = (end.inverse() * start).quaternion().toRotationMatrix();
+  double largest = 0;
+  for (int v = 0; v < cam.height; v += 8)
+    for (int u = 0; u < cam.width; u += 8) {
+      const Eigen::Vector2d px(u, v);
+      const Vec3 ray = R_end_start * cam.unproject(px, 1.0);
+      largest = std::max(largest, (cam.project(ray) - px).norm());
+    }
+  return largest;
+}
+
+TEST(CameraStage, AdaptiveMotionBlurTakesTheSamplesTheTurnNeeds) {
+  Scenario sc = river();
+  sc.render.motion_blur_samples = 16;
+  sc.render.motion_blur_step_px = 0.5;
+  sc.sensors.camera.exposure_ms = 40;
+  sc.sensors.camera.noise.reference_exposure_ms = 40;
+  Rendering r(sc);
+  CameraStage adaptive(sc, &r.renderer, RngStreams(1));
+  // Still: one render. A slow turn: as many as keep 0.5 px between two. A fast one: the most.
+  EXPECT_EQ(adaptive.blur_samples(frame(0.0)), 1);
+  const double slow = 0.05;  // rad/s: about 2 px over 40 ms at f = 817 px
+  const double motion_px = largest_turn_motion_px(sc, slow, 0.040);
+  ASSERT_GT(motion_px, 1.0);
+  ASSERT_LT(motion_px, 16 * 0.5);
+  const int expected = static_cast<int>(std::ceil(motion_px / 0.5));
+  EXPECT_EQ(adaptive.blur_samples(frame(slow)), expected);
+  EXPECT_EQ(adaptive.blur_samples(frame(1.0)), 16);
+  // The images are those of that many samples always.
+  const sim::StereoImages got = adaptive.capture(frame(slow));
+  EXPECT_EQ(adaptive.last_blur_samples(), expected);
+  Scenario fixed_sc = sc;
+  fixed_sc.render.motion_blur_samples = expected;
+  fixed_sc.render.motion_blur_step_px = 0;
+  CameraStage fixed(fixed_sc, &r.renderer, RngStreams(1));
+  EXPECT_EQ(fixed.blur_samples(frame(0.0)), expected);  // step 0: every frame, moving or not
+  EXPECT_EQ(got.left.pixels, fixed.capture(frame(slow)).left.pixels);
+}
+
 TEST(CameraStage, MotionBlurIsTheMeanOfRendersOverTheExposure) {
   Scenario sc = river();
   sc.render.motion_blur_samples = 4;
