@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -121,6 +122,36 @@ TEST(CameraSensor, VignettingFollowsTheCos4Law) {
       std::pow(std::cos(std::atan(std::hypot(c.cx_px / c.fx_px, c.cy_px / c.fy_px))), 4);
   EXPECT_NEAR(half.vignetting(0, 0), 1 - 0.5 * (1 - corner), 1e-12);
   EXPECT_DOUBLE_EQ(half.vignetting(c.cx_px, c.cy_px), 1.0);
+}
+
+// Without noise a pixel is its mean, rounded to the nearest DN with ties to even (as
+// std::nearbyint) and clipped to [0, 255]: a gain of 0.5 puts every odd input on a tie. The
+// image is 7 px wide, so both the two-pixel loop and its one-pixel tail are checked, with and
+// without vignetting (at strength 1e-12 its factors, stored as floats, are exactly 1).
+TEST(CameraSensor, PixelsRoundHalfToEvenAndClipWithoutNoise) {
+  for (const double vignetting : {0.0, 1e-12}) {
+    CameraOptions c = small_camera(7, 37);
+    c.noise.enabled = false;
+    c.vignetting_strength = vignetting;
+    for (const double gain : {0.5, 3.0}) {
+      c.noise.analog_gain = gain;
+      const PhotometricModel model(c);
+      cv::Mat img(37, 7, CV_8UC1);
+      for (int i = 0; i < 256; ++i) img.data[i] = static_cast<std::uint8_t>(i);
+      Rng rng(1);
+      model.apply(&img, &rng);
+      for (int i = 0; i < 256; ++i) {
+        const double mean = i * gain;
+        // Written out: the even neighbour on a tie, 255 above the range.
+        double expected = std::floor(mean);
+        if (mean - expected > 0.5 || (mean - expected == 0.5 && std::fmod(expected, 2.0) != 0))
+          expected += 1;
+        expected = std::min(expected, 255.0);
+        EXPECT_EQ(img.data[i], expected)
+            << "input " << i << ", gain " << gain << ", vignetting " << vignetting;
+      }
+    }
+  }
 }
 
 TEST(CameraSensor, StereoCalibrationErrorMovesOnlyTheTrueRightCamera) {
