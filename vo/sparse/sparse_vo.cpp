@@ -53,8 +53,12 @@ struct SparseStereoOdometry::Impl {
   std::vector<CircleMatch> circles;
   std::vector<StereoPointMatch> points;
   std::vector<SparseMatchInfo> infos;
-  // lk_refinement: this pair's and the previous pair's images, and reused point buffers.
-  cv::Mat img_l1, img_r1, img_l0, img_r0;
+  // lk_refinement: this pair's and the reference pair's images as OpenCV's one-level optical
+  // flow pyramids (bordered for the LK window; the left ones with their Scharr derivatives,
+  // which calcOpticalFlowPyrLK would otherwise compute again for every call), and reused point
+  // buffers. Built once per frame, they serve the three tracks of this frame and, as the
+  // reference pair, those of the frames that follow.
+  std::vector<cv::Mat> pyr_l1, pyr_r1, pyr_l0, pyr_r0;
   std::vector<cv::Point2f> lk_from, lk_to;
   std::vector<unsigned char> lk_status;
   std::vector<float> lk_error;
@@ -64,11 +68,11 @@ struct SparseStereoOdometry::Impl {
   // circle as `get` gives it; `set` stores the result. A circle whose track fails or moves
   // farther than lk_max_shift_px is marked for removal.
   template <class Get, class Set>
-  void lk_track(const cv::Mat& target, Get get, Set set) {
+  void lk_track(const std::vector<cv::Mat>& target, Get get, Set set) {
     lk_to.clear();
     for (const CircleMatch& c : circles) lk_to.push_back(get(c));
     const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.005);
-    cv::calcOpticalFlowPyrLK(img_l1, target, lk_from, lk_to, lk_status, lk_error,
+    cv::calcOpticalFlowPyrLK(pyr_l1, target, lk_from, lk_to, lk_status, lk_error,
                              cv::Size(options.lk_window_px, options.lk_window_px), 0, stop,
                              cv::OPTFLOW_USE_INITIAL_FLOW);
     for (std::size_t i = 0; i < circles.size(); ++i) {
@@ -91,16 +95,16 @@ struct SparseStereoOdometry::Impl {
       lk_from.emplace_back(static_cast<float>(c.u_lc), static_cast<float>(c.v_lc));
     lk_keep.assign(circles.size(), 1);
     lk_track(
-        img_r1, [](const CircleMatch& c) { return cv::Point2f(float(c.u_rc), float(c.v_lc)); },
+        pyr_r1, [](const CircleMatch& c) { return cv::Point2f(float(c.u_rc), float(c.v_lc)); },
         [](CircleMatch& c, const cv::Point2f& p) { c.u_rc = p.x; });
     lk_track(
-        img_l0, [](const CircleMatch& c) { return cv::Point2f(float(c.u_lp), float(c.v_lp)); },
+        pyr_l0, [](const CircleMatch& c) { return cv::Point2f(float(c.u_lp), float(c.v_lp)); },
         [](CircleMatch& c, const cv::Point2f& p) {
           c.u_lp = p.x;
           c.v_lp = p.y;
         });
     lk_track(
-        img_r0, [](const CircleMatch& c) { return cv::Point2f(float(c.u_rp), float(c.v_lp)); },
+        pyr_r0, [](const CircleMatch& c) { return cv::Point2f(float(c.u_rp), float(c.v_lp)); },
         [](CircleMatch& c, const cv::Point2f& p) { c.u_rp = p.x; });
     const double dmin = options.min_disparity_px;
     std::size_t kept = 0;
@@ -157,9 +161,10 @@ struct SparseStereoOdometry::Impl {
   void detect(const StereoFrame& frame) {
     detector.detect(frame.left, &l1);
     detector.detect(frame.right, &r1);
-    if (options.lk_refinement) {  // copies into buffers kept across frames: no allocation
-      frame.left.copyTo(img_l1);
-      frame.right.copyTo(img_r1);
+    if (options.lk_refinement) {  // into buffers kept across frames: no allocation
+      const cv::Size window(options.lk_window_px, options.lk_window_px);
+      cv::buildOpticalFlowPyramid(frame.left, pyr_l1, window, 0, /*withDerivatives=*/true);
+      cv::buildOpticalFlowPyramid(frame.right, pyr_r1, window, 0, /*withDerivatives=*/false);
     }
   }
 
@@ -224,8 +229,8 @@ struct SparseStereoOdometry::Impl {
       }
       std::swap(s.l0, s.l1);
       std::swap(s.r0, s.r1);
-      cv::swap(s.img_l0, s.img_l1);
-      cv::swap(s.img_r0, s.img_r1);
+      std::swap(s.pyr_l0, s.pyr_l1);
+      std::swap(s.pyr_r0, s.pyr_r1);
       s.has_previous = true;
       s.T_key_prev = SE3();
       s.key_frames_back = 1;
