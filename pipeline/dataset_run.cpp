@@ -163,10 +163,12 @@ std::vector<Track> make_dataset_tracks(const dataset::StereoDataset& d, const Sc
                                        const std::vector<dataset::DatasetFrame>& used) {
   const RngStreams rng(settings.seed);
   std::vector<Track> tracks;
-  for (const std::string& a : algorithms) {
+  std::vector<std::unique_ptr<vo::StereoOdometry>> vos =
+      make_vos(algorithms, d.rig, settings.pipeline, rng);
+  for (std::size_t i = 0; i < vos.size(); ++i) {
     Track t;
-    t.name = a;
-    t.vo = make_vo(a, d.rig, settings.pipeline, rng);
+    t.name = algorithms[i];
+    t.vo = std::move(vos[i]);
     t.results.resize(used.size());
     tracks.push_back(std::move(t));
   }

@@ -191,10 +191,12 @@ std::vector<Track> make_tracks(const Scenario& sc, const StereoRig& rig,
                                const SensorData& sensor_data, const Trajectory& camera_gt,
                                const SE3& T_W_C0, const RngStreams& rng) {
   std::vector<Track> tracks;
-  for (const std::string& a : sc.pipeline.vo) {
+  std::vector<std::unique_ptr<vo::StereoOdometry>> vos =
+      make_vos(sc.pipeline.vo, rig, sc.pipeline, rng);
+  for (std::size_t i = 0; i < vos.size(); ++i) {
     Track t;
-    t.name = a;
-    t.vo = make_vo(a, rig, sc.pipeline, rng);
+    t.name = sc.pipeline.vo[i];
+    t.vo = std::move(vos[i]);
     t.results.resize(camera_gt.size());
     for (auto& r : t.results) r.reason = "frame dropped";
     tracks.push_back(std::move(t));

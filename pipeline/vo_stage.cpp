@@ -2,27 +2,50 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "core/error.hpp"
 #include "core/yaml_io.hpp"
 #include "vo/dense/dense_vo.hpp"
 #include "vo/pnp/pnp_vo.hpp"
 #include "vo/registry.hpp"
+#include "vo/sparse/shared_detection.hpp"
 #include "vo/sparse/sparse_vo.hpp"
 
 namespace driftlab::pipeline {
 
-std::unique_ptr<vo::StereoOdometry> make_vo(const std::string& name, const StereoRig& rig,
-                                            const PipelineOptions& p, const RngStreams& rng) {
+namespace {
+
+std::unique_ptr<vo::StereoOdometry> make_vo(
+    const std::string& name, const StereoRig& rig, const PipelineOptions& p, const RngStreams& rng,
+    const std::shared_ptr<vo::sparse::SharedDetection>& sparse_detection) {
   Rng stream = rng.stream("vo." + name);
-  if (name == "sparse") return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse, stream);
+  if (name == "sparse")
+    return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse, stream, sparse_detection);
   if (name == "sparse_kf")
-    return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse_kf, stream);
+    return std::make_unique<vo::SparseStereoOdometry>(rig, p.sparse_kf, stream, sparse_detection);
   if (name == "pnp") return std::make_unique<vo::PnpStereoOdometry>(rig, p.pnp, stream);
   if (name == "dense") return std::make_unique<vo::DenseStereoOdometry>(rig, p.dense, stream);
   if (auto v = vo::make_registered_vo(name, rig, stream, p.plugins)) return v;
   std::string names;
   for (const auto& n : vo::available_vo_names()) names += (names.empty() ? "" : ", ") + n;
   throw UserError(fmt::format("pipeline.vo: got '{}', expected one of: {}", name, names));
+}
+
+}  // namespace
+
+std::vector<std::unique_ptr<vo::StereoOdometry>> make_vos(const std::vector<std::string>& names,
+                                                          const StereoRig& rig,
+                                                          const PipelineOptions& p,
+                                                          const RngStreams& rng) {
+  std::shared_ptr<vo::sparse::SharedDetection> sparse_detection;
+  const auto settings = vo::sparse::detection_settings(p.sparse);
+  if (std::ranges::count(names, "sparse") > 0 && std::ranges::count(names, "sparse_kf") > 0 &&
+      settings == vo::sparse::detection_settings(p.sparse_kf))
+    sparse_detection = std::make_shared<vo::sparse::SharedDetection>(settings);
+  std::vector<std::unique_ptr<vo::StereoOdometry>> vos;
+  for (const std::string& name : names) vos.push_back(make_vo(name, rig, p, rng, sparse_detection));
+  return vos;
 }
 
 std::string vo_csv_header(const std::string& name) {

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/camera.hpp"
 #include "core/rng.hpp"
@@ -12,11 +13,15 @@
 
 namespace driftlab::pipeline {
 
-/// The VO `name` (built-in, or registered: vo/registry.hpp) on `rig`, a built-in one with its
-/// options from `pipeline`, each with its own random stream ("vo.<name>") of `rng`. UserError
-/// for an unknown name.
-std::unique_ptr<vo::StereoOdometry> make_vo(const std::string& name, const StereoRig& rig,
-                                            const PipelineOptions& pipeline, const RngStreams& rng);
+/// The VOs `names` (built-in, or registered: vo/registry.hpp) on `rig`, in that order, the
+/// built-in ones with their options from `pipeline`, each with its own random stream
+/// ("vo.<name>") of `rng`. `sparse` and `sparse_kf` share their feature detection when their
+/// detection options agree (the shipped ones do): the same results, one detection a frame.
+/// UserError for an unknown name.
+std::vector<std::unique_ptr<vo::StereoOdometry>> make_vos(const std::vector<std::string>& names,
+                                                          const StereoRig& rig,
+                                                          const PipelineOptions& pipeline,
+                                                          const RngStreams& rng);
 
 /// frames.csv columns of one VO: ",NAME_valid,NAME_inliers,NAME_valid_depth_px,
 /// NAME_mean_depth_m,NAME_ref_frames,NAME_ms".

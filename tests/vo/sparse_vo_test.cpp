@@ -6,8 +6,10 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <future>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <vector>
 
@@ -20,6 +22,7 @@
 #include "tests/vo/vo_test_sequences.hpp"
 #include "vo/sparse/circle_matcher.hpp"
 #include "vo/sparse/features.hpp"
+#include "vo/sparse/shared_detection.hpp"
 #include "vo/sparse/sparse_options.hpp"
 #include "vo/sparse/sparse_vo.hpp"
 #include "vo/sparse/stereo_motion.hpp"
@@ -502,6 +505,70 @@ TEST(SparseVoTest, DeterministicBytesAcrossInstancesAndResets) {
   SparseStereoOdometry a(seq.rig, SparseVoOptions{}, stream);
   SparseStereoOdometry b(seq.rig, SparseVoOptions{}, stream);
   test::expect_same_bytes_across_instances_and_reset(a, b, run);
+}
+
+// sparse and sparse_kf sharing one detection per pair, processing each frame side by side as a
+// run does, give byte for byte what each gives detecting alone; each pair is detected once.
+TEST(SparseVoTest, SharedDetectionGivesTheSameBytesAsDetectingAlone) {
+  const test::Sequence& seq = short_640();
+  SparseVoOptions kf;
+  kf.keyframes = true;
+  const Rng s1 = RngStreams(2015).stream("vo.sparse"), s2 = RngStreams(2015).stream("vo.kf");
+  auto bytes_of = [](SparseStereoOdometry& vo, const StereoFrame& f, std::vector<double>* out) {
+    test::append_result_bytes(vo.process(f), out);
+    for (const SparseMatchInfo& m : vo.last_matches())
+      out->insert(out->end(), {m.u_lc, m.v_lc, m.u_rc, m.u_lp, m.v_lp, m.u_rp});
+  };
+  std::vector<double> alone_a, alone_b, shared_a, shared_b;
+  {
+    SparseStereoOdometry a(seq.rig, SparseVoOptions{}, s1), b(seq.rig, kf, s2);
+    for (const StereoFrame& f : seq.frames) {
+      bytes_of(a, f, &alone_a);
+      bytes_of(b, f, &alone_b);
+    }
+  }
+  const auto shared = std::make_shared<sparse::SharedDetection>(sparse::detection_settings(kf));
+  SparseStereoOdometry a(seq.rig, SparseVoOptions{}, s1, shared), b(seq.rig, kf, s2, shared);
+  for (const StereoFrame& f : seq.frames) {
+    auto other = std::async(std::launch::async, [&] { bytes_of(b, f, &shared_b); });
+    bytes_of(a, f, &shared_a);
+    other.get();
+  }
+  ASSERT_GT(alone_a.size(), 20u);
+  EXPECT_EQ(0, std::memcmp(alone_a.data(), shared_a.data(), alone_a.size() * sizeof(double)));
+  ASSERT_EQ(alone_b.size(), shared_b.size());
+  EXPECT_EQ(0, std::memcmp(alone_b.data(), shared_b.data(), alone_b.size() * sizeof(double)));
+  EXPECT_EQ(shared->detected(), static_cast<long>(seq.frames.size()));
+  EXPECT_EQ(shared->shared(), static_cast<long>(seq.frames.size()));
+  // Sharing needs equal detection options.
+  SparseVoOptions other_nms;
+  other_nms.nms_threshold += 1;
+  EXPECT_THROW(SparseStereoOdometry(seq.rig, other_nms, s1, shared), InternalError);
+}
+
+// The shared result is keyed by the images' bytes, not by their buffers: a buffer refilled with
+// other bytes is detected anew, the same bytes in another buffer are not.
+TEST(SparseVoTest, SharedDetectionComparesTheImagesBytes) {
+  const test::Sequence& seq = short_640();
+  const SparseVoOptions o;
+  sparse::SharedDetection shared(sparse::detection_settings(o));
+  sparse::PairDetector detector(seq.rig.camera.width, seq.rig.camera.height, o);
+  cv::Mat left = seq.frames[0].left.clone(), right = seq.frames[0].right.clone();
+  auto first = shared.get(left, right, &detector);
+  auto again = shared.get(left.clone(), right.clone(), &detector);
+  EXPECT_EQ(first.get(), again.get());
+  left.at<std::uint8_t>(100, 100) ^= 0x40;
+  const auto changed = shared.get(left, right, &detector);
+  EXPECT_NE(first.get(), changed.get());
+  EXPECT_EQ(shared.detected(), 2);
+  EXPECT_EQ(shared.shared(), 1);
+  // A pair nobody holds any more is refilled for the next one, not reallocated.
+  const sparse::PairFeatures* released = first.get();
+  first.reset();
+  again.reset();
+  const auto next = shared.get(seq.frames[1].left, seq.frames[1].right, &detector);
+  EXPECT_EQ(next.get(), released);
+  EXPECT_EQ(shared.detected(), 3);
 }
 
 TEST(SparseVoTest, SingleStageMatchingTracksToo) {

@@ -12,22 +12,26 @@
 #include "core/stopwatch.hpp"
 #include "vo/sparse/circle_matcher.hpp"
 #include "vo/sparse/features.hpp"
+#include "vo/sparse/shared_detection.hpp"
 #include "vo/sparse/stereo_motion.hpp"
 #include "vo/sparse/window_ba.hpp"
 
 namespace driftlab::vo {
 
 using sparse::CircleMatch;
-using sparse::ImageFeatures;
 using sparse::StereoPointMatch;
 
 struct SparseStereoOdometry::Impl {
-  Impl(const StereoRig& rig_in, const SparseVoOptions& options_in, Rng rng_in)
+  Impl(const StereoRig& rig_in, const SparseVoOptions& options_in, Rng rng_in,
+       std::shared_ptr<sparse::SharedDetection> shared_in)
       : rig(rig_in),
         options(options_in),
         initial_rng(rng_in),
         rng(rng_in),
         detector(rig_in.camera.width, rig_in.camera.height, options_in),
+        shared(shared_in ? std::move(shared_in)
+                         : std::make_shared<sparse::SharedDetection>(
+                               sparse::detection_settings(options_in))),
         matcher(rig_in, options_in),
         estimator(rig_in, options_in) {
     if (options_in.refine == SparseRefine::kWindowBa)
@@ -38,13 +42,16 @@ struct SparseStereoOdometry::Impl {
   SparseVoOptions options;
   Rng initial_rng;
   Rng rng;
-  sparse::FeatureDetector detector;
+  sparse::PairDetector detector;
+  // Where the pairs' features come from: shared with the run's other sparse VOs that detect
+  // alike, or this VO's own.
+  std::shared_ptr<sparse::SharedDetection> shared;
   sparse::CircleMatcher matcher;
   sparse::StereoMotionEstimator estimator;
   std::unique_ptr<sparse::WindowBundleAdjuster> window_ba;  // refine: window_ba only
-  // Current (1) and reference (0) pair; swapped, never copied, when the reference moves (after
-  // each frame without keyframes).
-  ImageFeatures l1, r1, l0, r0;
+  // The current pair and the reference pair (the previous one, or the keyframe), each with
+  // its features and, for lk_refinement, its images' LK pyramids.
+  std::shared_ptr<const sparse::PairFeatures> cur, ref;
   bool has_previous = false;
   // keyframes: the motion from the reference (keyframe) to the previous frame, and how many
   // frames back the reference is from the current one.
@@ -53,12 +60,10 @@ struct SparseStereoOdometry::Impl {
   std::vector<CircleMatch> circles;
   std::vector<StereoPointMatch> points;
   std::vector<SparseMatchInfo> infos;
-  // lk_refinement: this pair's and the reference pair's images as OpenCV's one-level optical
-  // flow pyramids (bordered for the LK window; the left ones with their Scharr derivatives,
-  // which calcOpticalFlowPyrLK would otherwise compute again for every call), and reused point
-  // buffers. Built once per frame, they serve the three tracks of this frame and, as the
-  // reference pair, those of the frames that follow.
-  std::vector<cv::Mat> pyr_l1, pyr_r1, pyr_l0, pyr_r0;
+  // lk_refinement: reused point buffers. The pairs' pyramids (built once per pair, the left
+  // one with its Scharr derivatives, which calcOpticalFlowPyrLK would otherwise compute again
+  // for every track) serve the three tracks of this frame and, as the reference pair, those of
+  // the frames that follow.
   std::vector<cv::Point2f> lk_from, lk_to;
   std::vector<unsigned char> lk_status;
   std::vector<float> lk_error;
@@ -72,7 +77,7 @@ struct SparseStereoOdometry::Impl {
     lk_to.clear();
     for (const CircleMatch& c : circles) lk_to.push_back(get(c));
     const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.005);
-    cv::calcOpticalFlowPyrLK(pyr_l1, target, lk_from, lk_to, lk_status, lk_error,
+    cv::calcOpticalFlowPyrLK(cur->pyr_left, target, lk_from, lk_to, lk_status, lk_error,
                              cv::Size(options.lk_window_px, options.lk_window_px), 0, stop,
                              cv::OPTFLOW_USE_INITIAL_FLOW);
     for (std::size_t i = 0; i < circles.size(); ++i) {
@@ -95,16 +100,19 @@ struct SparseStereoOdometry::Impl {
       lk_from.emplace_back(static_cast<float>(c.u_lc), static_cast<float>(c.v_lc));
     lk_keep.assign(circles.size(), 1);
     lk_track(
-        pyr_r1, [](const CircleMatch& c) { return cv::Point2f(float(c.u_rc), float(c.v_lc)); },
+        cur->pyr_right,
+        [](const CircleMatch& c) { return cv::Point2f(float(c.u_rc), float(c.v_lc)); },
         [](CircleMatch& c, const cv::Point2f& p) { c.u_rc = p.x; });
     lk_track(
-        pyr_l0, [](const CircleMatch& c) { return cv::Point2f(float(c.u_lp), float(c.v_lp)); },
+        ref->pyr_left,
+        [](const CircleMatch& c) { return cv::Point2f(float(c.u_lp), float(c.v_lp)); },
         [](CircleMatch& c, const cv::Point2f& p) {
           c.u_lp = p.x;
           c.v_lp = p.y;
         });
     lk_track(
-        pyr_r0, [](const CircleMatch& c) { return cv::Point2f(float(c.u_rp), float(c.v_lp)); },
+        ref->pyr_right,
+        [](const CircleMatch& c) { return cv::Point2f(float(c.u_rp), float(c.v_lp)); },
         [](CircleMatch& c, const cv::Point2f& p) { c.u_rp = p.x; });
     const double dmin = options.min_disparity_px;
     std::size_t kept = 0;
@@ -157,23 +165,17 @@ struct SparseStereoOdometry::Impl {
     }
   }
 
-  // Features of the current pair (and its images, for lk_refinement).
-  void detect(const StereoFrame& frame) {
-    detector.detect(frame.left, &l1);
-    detector.detect(frame.right, &r1);
-    if (options.lk_refinement) {  // into buffers kept across frames: no allocation
-      const cv::Size window(options.lk_window_px, options.lk_window_px);
-      cv::buildOpticalFlowPyramid(frame.left, pyr_l1, window, 0, /*withDerivatives=*/true);
-      cv::buildOpticalFlowPyramid(frame.right, pyr_r1, window, 0, /*withDerivatives=*/false);
-    }
-  }
+  // Features of the current pair (and its LK pyramids, for lk_refinement).
+  void detect(const StereoFrame& frame) { cur = shared->get(frame.left, frame.right, &detector); }
 
   // Why the current or the reference pair has too few features to match; nullptr if neither.
   const char* feature_shortage() const {
     const auto min_features = static_cast<std::size_t>(options.min_inliers);
-    if (l1.all.features.size() < min_features || r1.all.features.size() < min_features)
+    if (cur->left.all.features.size() < min_features ||
+        cur->right.all.features.size() < min_features)
       return "too few features in the current images (no texture?)";
-    if (l0.all.features.size() < min_features || r0.all.features.size() < min_features)
+    if (ref->left.all.features.size() < min_features ||
+        ref->right.all.features.size() < min_features)
       return "too few features in the previous images (no texture?)";
     return nullptr;
   }
@@ -189,7 +191,7 @@ struct SparseStereoOdometry::Impl {
   Stage match_and_estimate(bool coarse_only, const SE3* prior) {
     Stage out;
     auto t = SteadyClock::now();
-    matcher.match(l1, r1, l0, r0, coarse_only, prior, &circles);
+    matcher.match(cur->left, cur->right, ref->left, ref->right, coarse_only, prior, &circles);
     if (!coarse_only && options.lk_refinement && !circles.empty()) lk_refine();
     out.match_ms = ms_since(t);
     t = SteadyClock::now();
@@ -225,12 +227,10 @@ struct SparseStereoOdometry::Impl {
     ~Advance() {
       if (keep_reference) {
         ++s.key_frames_back;
+        s.cur.reset();  // free for the next pair
         return;
       }
-      std::swap(s.l0, s.l1);
-      std::swap(s.r0, s.r1);
-      std::swap(s.pyr_l0, s.pyr_l1);
-      std::swap(s.pyr_r0, s.pyr_r1);
+      s.ref = std::move(s.cur);
       s.has_previous = true;
       s.T_key_prev = SE3();
       s.key_frames_back = 1;
@@ -239,7 +239,8 @@ struct SparseStereoOdometry::Impl {
 };
 
 SparseStereoOdometry::SparseStereoOdometry(const StereoRig& rig, const SparseVoOptions& options,
-                                           Rng rng) {
+                                           Rng rng,
+                                           std::shared_ptr<sparse::SharedDetection> shared) {
   const std::string rig_problems = validate(rig);
   if (!rig_problems.empty()) throw UserError("SparseStereoOdometry: invalid rig: " + rig_problems);
   yaml::validate_or_throw(options, "SparseStereoOdometry");
@@ -250,7 +251,9 @@ SparseStereoOdometry::SparseStereoOdometry(const StereoRig& rig, const SparseVoO
                     std::to_string(rig.camera.height) + " px is too small, expected at least " +
                     std::to_string(min_side) + " px a side");
   }
-  impl_ = std::make_unique<Impl>(rig, options, rng);
+  if (shared && !(shared->settings() == sparse::detection_settings(options)))
+    throw InternalError("SparseStereoOdometry: shared detection with other detection options");
+  impl_ = std::make_unique<Impl>(rig, options, rng, std::move(shared));
 }
 
 SparseStereoOdometry::~SparseStereoOdometry() = default;
@@ -260,11 +263,13 @@ const SparseVoOptions& SparseStereoOdometry::options() const { return impl_->opt
 std::span<const MatchInfo> SparseStereoOdometry::last_matches() const { return impl_->infos; }
 
 int SparseStereoOdometry::last_feature_count() const {
-  return static_cast<int>(impl_->l0.all.features.size());
+  return impl_->ref ? static_cast<int>(impl_->ref->left.all.features.size()) : 0;
 }
 
 void SparseStereoOdometry::reset() {
   impl_->has_previous = false;
+  impl_->cur.reset();
+  impl_->ref.reset();
   impl_->T_key_prev = SE3();
   impl_->key_frames_back = 1;
   impl_->rng = impl_->initial_rng;

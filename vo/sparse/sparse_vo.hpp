@@ -22,6 +22,10 @@
 
 namespace driftlab::vo {
 
+namespace sparse {
+class SharedDetection;
+}
+
 /// The sparse VO's matches are StereoOdometry's MatchInfo.
 using SparseMatchInfo = MatchInfo;
 
@@ -30,7 +34,10 @@ class SparseStereoOdometry final : public StereoOdometry {
  public:
   /// Throws UserError when the rig or the options are invalid. `rng` is the stream RANSAC
   /// draws from (e.g. RngStreams::stream("vo.sparse")).
-  SparseStereoOdometry(const StereoRig& rig, const SparseVoOptions& options, Rng rng);
+  /// `shared`: detection shared with other sparse VOs of the same images (made with
+  /// detection_settings() equal to this VO's); null detects alone. The same results either way.
+  SparseStereoOdometry(const StereoRig& rig, const SparseVoOptions& options, Rng rng,
+                       std::shared_ptr<sparse::SharedDetection> shared = nullptr);
   ~SparseStereoOdometry() override;
 
   VoResult process(const StereoFrame& frame) override;
