@@ -252,8 +252,8 @@ std::vector<std::string> evaluate_tracks(const dataset::StereoDataset& d, const 
   std::string tables, sections;
   for (const Track& t : tracks) {
     if (t.vo)
-      (*metrics)["timing"]["vo_ms_per_frame"][t.name] =
-          used.empty() ? 0.0 : t.vo_ms / static_cast<double>(used.size());
+      add_vo_timing(*t.vo, t.name, used.empty() ? 0.0 : t.vo_ms / static_cast<double>(used.size()),
+                    metrics);
     if (d.camera_gt.empty()) {
       briefs.push_back(t.name + ": no ground truth, estimate only");
       continue;

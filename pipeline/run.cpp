@@ -259,8 +259,7 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
     const std::string csv = eval::sections_csv(e);
     sections += sections.empty() ? csv : csv.substr(csv.find('\n') + 1);
     if (tr.vo)
-      (*metrics)["timing"]["vo_ms_per_frame"][tr.name] =
-          tr.vo_ms / static_cast<double>(camera_gt.size());
+      add_vo_timing(*tr.vo, tr.name, tr.vo_ms / static_cast<double>(camera_gt.size()), metrics);
   }
   return report;
 }

@@ -48,6 +48,16 @@ std::vector<std::unique_ptr<vo::StereoOdometry>> make_vos(const std::vector<std:
   return vos;
 }
 
+void add_vo_timing(const vo::StereoOdometry& vo, const std::string& name, double ms_per_frame,
+                   nlohmann::json* metrics) {
+  (*metrics)["timing"]["vo_ms_per_frame"][name] = ms_per_frame;
+  if (const auto* sparse = dynamic_cast<const vo::SparseStereoOdometry*>(&vo)) {
+    const auto counts = sparse->detection_counts();
+    (*metrics)["timing"]["sparse_pairs"][name] = {{"detected", counts.detected},
+                                                  {"shared", counts.shared}};
+  }
+}
+
 std::string vo_csv_header(const std::string& name) {
   return fmt::format(
       ",{0}_valid,{0}_inliers,{0}_valid_depth_px,{0}_mean_depth_m,{0}_ref_frames,{0}_ms", name);

@@ -260,6 +260,16 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   EXPECT_NEAR(m["track"]["length_m"].get<double>(), length, 1e-9);
   EXPECT_GT(m["timing"]["render_pairs_per_s"].get<double>(), 0);
   EXPECT_GT(m["timing"]["total_s"].get<double>(), 0);
+  // The shipped sparse and sparse_kf share their detection: each pair detected once, by one of
+  // the two, and taken by the other.
+  {
+    const auto& p = m["timing"]["sparse_pairs"];
+    const long detected =
+        p["sparse"]["detected"].get<long>() + p["sparse_kf"]["detected"].get<long>();
+    const long shared = p["sparse"]["shared"].get<long>() + p["sparse_kf"]["shared"].get<long>();
+    EXPECT_EQ(detected, frames);
+    EXPECT_EQ(shared, frames);
+  }
   for (const char* algo : {"sparse", "sparse_ca", "sparse_kf", "sparse_kf_ca"}) {
     const auto& a = m["algorithms"][algo];
     for (const char* k : {"rmse_3d_m", "rmse_2d_m", "max_3d_m", "max_2d_m", "rmse_3d_pct"})

@@ -540,6 +540,10 @@ TEST(SparseVoTest, SharedDetectionGivesTheSameBytesAsDetectingAlone) {
   EXPECT_EQ(0, std::memcmp(alone_b.data(), shared_b.data(), alone_b.size() * sizeof(double)));
   EXPECT_EQ(shared->detected(), static_cast<long>(seq.frames.size()));
   EXPECT_EQ(shared->shared(), static_cast<long>(seq.frames.size()));
+  const auto ca = a.detection_counts(), cb = b.detection_counts();
+  EXPECT_EQ(ca.detected + cb.detected, shared->detected());
+  EXPECT_EQ(ca.shared + cb.shared, shared->shared());
+  EXPECT_EQ(ca.detected + ca.shared, static_cast<long>(seq.frames.size()));
   // Sharing needs equal detection options.
   SparseVoOptions other_nms;
   other_nms.nms_threshold += 1;
@@ -554,11 +558,11 @@ TEST(SparseVoTest, SharedDetectionComparesTheImagesBytes) {
   sparse::SharedDetection shared(sparse::detection_settings(o));
   sparse::PairDetector detector(seq.rig.camera.width, seq.rig.camera.height, o);
   cv::Mat left = seq.frames[0].left.clone(), right = seq.frames[0].right.clone();
-  auto first = shared.get(left, right, &detector);
-  auto again = shared.get(left.clone(), right.clone(), &detector);
+  auto first = shared.get(left, right, &detector).features;
+  auto again = shared.get(left.clone(), right.clone(), &detector).features;
   EXPECT_EQ(first.get(), again.get());
   left.at<std::uint8_t>(100, 100) ^= 0x40;
-  const auto changed = shared.get(left, right, &detector);
+  const auto changed = shared.get(left, right, &detector).features;
   EXPECT_NE(first.get(), changed.get());
   EXPECT_EQ(shared.detected(), 2);
   EXPECT_EQ(shared.shared(), 1);
@@ -566,7 +570,7 @@ TEST(SparseVoTest, SharedDetectionComparesTheImagesBytes) {
   const sparse::PairFeatures* released = first.get();
   first.reset();
   again.reset();
-  const auto next = shared.get(seq.frames[1].left, seq.frames[1].right, &detector);
+  const auto next = shared.get(seq.frames[1].left, seq.frames[1].right, &detector).features;
   EXPECT_EQ(next.get(), released);
   EXPECT_EQ(shared.detected(), 3);
 }

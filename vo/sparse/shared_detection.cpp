@@ -52,8 +52,8 @@ std::shared_ptr<SharedDetection::Entry> SharedDetection::free_entry() {
   return pool_.back();
 }
 
-std::shared_ptr<const PairFeatures> SharedDetection::get(const cv::Mat& left, const cv::Mat& right,
-                                                         PairDetector* detector) {
+SharedDetection::Got SharedDetection::get(const cv::Mat& left, const cv::Mat& right,
+                                          PairDetector* detector) {
   std::shared_ptr<Entry> entry;
   std::shared_future<void> done;
   std::promise<void> promise;
@@ -88,7 +88,7 @@ std::shared_ptr<const PairFeatures> SharedDetection::get(const cv::Mat& left, co
     done.get();  // rethrows the detecting caller's error
   }
   // The aliasing constructor: the features, kept alive by their entry.
-  return std::shared_ptr<const PairFeatures>(entry, &entry->features);
+  return {std::shared_ptr<const PairFeatures>(entry, &entry->features), mine};
 }
 
 long SharedDetection::detected() const {

@@ -59,9 +59,12 @@ class SharedDetection {
   explicit SharedDetection(const DetectionSettings& settings) : settings_(settings) {}
   const DetectionSettings& settings() const { return settings_; }
 
+  struct Got {
+    std::shared_ptr<const PairFeatures> features;
+    bool detected_here = false;  ///< false: taken from the caller that detected them
+  };
   /// The features of (left, right), detected by `detector` unless another caller did.
-  std::shared_ptr<const PairFeatures> get(const cv::Mat& left, const cv::Mat& right,
-                                          PairDetector* detector);
+  Got get(const cv::Mat& left, const cv::Mat& right, PairDetector* detector);
   /// How many pairs were detected and how many were taken from another caller (the guard
   /// counters: a run that shares should take about half).
   long detected() const;

@@ -46,6 +46,7 @@ struct SparseStereoOdometry::Impl {
   // Where the pairs' features come from: shared with the run's other sparse VOs that detect
   // alike, or this VO's own.
   std::shared_ptr<sparse::SharedDetection> shared;
+  SparseStereoOdometry::DetectionCounts counts;
   sparse::CircleMatcher matcher;
   sparse::StereoMotionEstimator estimator;
   std::unique_ptr<sparse::WindowBundleAdjuster> window_ba;  // refine: window_ba only
@@ -166,7 +167,11 @@ struct SparseStereoOdometry::Impl {
   }
 
   // Features of the current pair (and its LK pyramids, for lk_refinement).
-  void detect(const StereoFrame& frame) { cur = shared->get(frame.left, frame.right, &detector); }
+  void detect(const StereoFrame& frame) {
+    sparse::SharedDetection::Got got = shared->get(frame.left, frame.right, &detector);
+    cur = std::move(got.features);
+    ++(got.detected_here ? counts.detected : counts.shared);
+  }
 
   // Why the current or the reference pair has too few features to match; nullptr if neither.
   const char* feature_shortage() const {
@@ -261,6 +266,10 @@ SparseStereoOdometry::~SparseStereoOdometry() = default;
 const SparseVoOptions& SparseStereoOdometry::options() const { return impl_->options; }
 
 std::span<const MatchInfo> SparseStereoOdometry::last_matches() const { return impl_->infos; }
+
+SparseStereoOdometry::DetectionCounts SparseStereoOdometry::detection_counts() const {
+  return impl_->counts;
+}
 
 int SparseStereoOdometry::last_feature_count() const {
   return impl_->ref ? static_cast<int>(impl_->ref->left.all.features.size()) : 0;

@@ -51,6 +51,14 @@ class SparseStereoOdometry final : public StereoOdometry {
   /// Features detected in the last left image (diagnostics).
   int last_feature_count() const;
 
+  /// Pairs this VO detected itself and pairs it took from another VO sharing its detection,
+  /// since construction.
+  struct DetectionCounts {
+    long detected = 0;
+    long shared = 0;
+  };
+  DetectionCounts detection_counts() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
