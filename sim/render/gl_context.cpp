@@ -10,6 +10,8 @@
 
 #include <fmt/format.h>
 
+#include <array>
+#include <atomic>
 #include <vector>
 
 #include "core/error.hpp"
@@ -21,6 +23,35 @@ std::string gl_description() {
   const auto* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
   const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   return fmt::format("OpenGL {} / {}", version ? version : "?", renderer ? renderer : "?");
+}
+
+// glad keeps one set of gl* function pointers for the whole process. Contexts of one backend
+// share them; a context of the other backend (OSMesa and EGL in one process, as the renderer
+// tests do) reloads them when it is made current, or its calls would go to the other library.
+std::atomic<GLADloadfunc> g_loaded_by{nullptr};
+
+// Live contexts by backend, so that mixing them fails with a clear error (create_gl_context).
+std::array<std::atomic<int>, 2> g_live_contexts{};
+
+// Counts one live context of `backend` for as long as it exists.
+class LiveCount {
+ public:
+  explicit LiveCount(RenderBackend backend) : slot_(&g_live_contexts[static_cast<int>(backend)]) {
+    ++*slot_;
+  }
+  ~LiveCount() { --*slot_; }
+  LiveCount(const LiveCount&) = delete;
+  LiveCount& operator=(const LiveCount&) = delete;
+
+ private:
+  std::atomic<int>* slot_;
+};
+
+void load_gl_functions(GLADloadfunc loader, const char* backend) {
+  if (g_loaded_by.load() == loader) return;
+  if (!gladLoadGL(loader))
+    throw UserError(fmt::format("render.backend {}: loading the OpenGL functions failed", backend));
+  g_loaded_by.store(loader);
 }
 
 class OsmesaContext : public GlContext {
@@ -44,8 +75,6 @@ class OsmesaContext : public GlContext {
           "core profile context (is Mesa's libOSMesa 22 or newer installed? scripts/setup-deps "
           "installs it)");
     make_current();
-    if (!gladLoadGL(reinterpret_cast<GLADloadfunc>(OSMesaGetProcAddress)))
-      throw UserError("render.backend osmesa: loading the OpenGL functions failed");
     description_ = gl_description();
   }
   ~OsmesaContext() override {
@@ -55,41 +84,65 @@ class OsmesaContext : public GlContext {
     // All drawing goes to framebuffer objects; the default buffer is a token 1x1.
     if (!OSMesaMakeCurrent(ctx_, buffer_.data(), GL_UNSIGNED_BYTE, 1, 1))
       throw UserError("render.backend osmesa: OSMesaMakeCurrent failed");
+    load_gl_functions(reinterpret_cast<GLADloadfunc>(OSMesaGetProcAddress), "osmesa");
   }
 
  private:
+  LiveCount live_{RenderBackend::kOsmesa};
   OSMesaContext ctx_ = nullptr;
   std::vector<unsigned char> buffer_ = std::vector<unsigned char>(16);
 };
 
+// The EGL display, tried in turn: the default one (X, Wayland, or a GPU driver that picks its
+// device); the first GPU device that initialises (EGL_EXT_platform_device: NVIDIA without a
+// display server); Mesa's surfaceless platform (llvmpipe on a machine without a GPU).
+EGLDisplay open_display() {
+  EGLint major = 0, minor = 0;
+  EGLDisplay d = eglGetDisplay(EGL_DEFAULT_DISPLAY);
+  if (d != EGL_NO_DISPLAY && eglInitialize(d, &major, &minor)) return d;
+  auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
+      eglGetProcAddress("eglGetPlatformDisplayEXT"));
+  auto query_devices =
+      reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+  if (get_platform_display && query_devices) {
+    std::vector<EGLDeviceEXT> devices(16);
+    EGLint count = 0;
+    if (query_devices(static_cast<EGLint>(devices.size()), devices.data(), &count))
+      for (EGLint i = 0; i < count; ++i) {
+        d = get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr);
+        if (d != EGL_NO_DISPLAY && eglInitialize(d, &major, &minor)) return d;
+      }
+  }
+  if (get_platform_display) {
+    d = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    if (d != EGL_NO_DISPLAY && eglInitialize(d, &major, &minor)) return d;
+  }
+  throw UserError(
+      fmt::format("render.backend egl: no EGL display could be initialised (EGL error 0x{:x}); use "
+                  "render.backend: osmesa on machines without an EGL driver",
+                  eglGetError()));
+}
+
 class EglContext : public GlContext {
  public:
   EglContext() {
-    display_ = eglGetDisplay(EGL_DEFAULT_DISPLAY);
-    EGLint major = 0, minor = 0;
-    if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) {
-      // No default display (no X, no GPU device): Mesa's surfaceless platform.
-      auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
-          eglGetProcAddress("eglGetPlatformDisplayEXT"));
-      if (get_platform_display)
-        display_ =
-            get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-      if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor))
-        throw UserError(fmt::format(
-            "render.backend egl: no EGL display could be initialised (EGL error 0x{:x}); use "
-            "render.backend: osmesa on machines without an EGL driver",
-            eglGetError()));
-    }
+    display_ = open_display();
     if (!eglBindAPI(EGL_OPENGL_API))
       throw UserError("render.backend egl: the EGL implementation has no desktop OpenGL API");
     const EGLint config_attribs[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE,
                                      EGL_OPENGL_BIT, EGL_NONE};
     EGLConfig config = nullptr;
     EGLint n = 0;
-    if (!eglChooseConfig(display_, config_attribs, &config, 1, &n) || n < 1)
-      throw UserError("render.backend egl: no EGL config with OpenGL and pbuffer support");
-    const EGLint pbuffer_attribs[] = {EGL_WIDTH, 1, EGL_HEIGHT, 1, EGL_NONE};
-    surface_ = eglCreatePbufferSurface(display_, config, pbuffer_attribs);
+    if (eglChooseConfig(display_, config_attribs, &config, 1, &n) && n == 1) {
+      const EGLint pbuffer_attribs[] = {EGL_WIDTH, 1, EGL_HEIGHT, 1, EGL_NONE};
+      surface_ = eglCreatePbufferSurface(display_, config, pbuffer_attribs);
+    } else {
+      // No pbuffer configs (some GPU device displays): all drawing goes to framebuffer objects
+      // anyway, so a context without any surface (EGL_KHR_surfaceless_context) will do.
+      const EGLint any_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+      if (!eglChooseConfig(display_, any_attribs, &config, 1, &n) || n < 1)
+        throw UserError("render.backend egl: no EGL config with desktop OpenGL support");
+    }
     const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
                                       4,
                                       EGL_CONTEXT_MINOR_VERSION,
@@ -103,8 +156,6 @@ class EglContext : public GlContext {
           "render.backend egl: creating an OpenGL 4.5 core context failed (EGL error 0x{:x})",
           eglGetError()));
     make_current();
-    if (!gladLoadGL(reinterpret_cast<GLADloadfunc>(eglGetProcAddress)))
-      throw UserError("render.backend egl: loading the OpenGL functions failed");
     description_ = gl_description();
   }
   ~EglContext() override {
@@ -119,9 +170,11 @@ class EglContext : public GlContext {
     if (!eglMakeCurrent(display_, surface_, surface_, context_))
       throw UserError(fmt::format("render.backend egl: eglMakeCurrent failed (EGL error 0x{:x})",
                                   eglGetError()));
+    load_gl_functions(reinterpret_cast<GLADloadfunc>(eglGetProcAddress), "egl");
   }
 
  private:
+  LiveCount live_{RenderBackend::kEgl};
   EGLDisplay display_ = EGL_NO_DISPLAY;
   EGLSurface surface_ = EGL_NO_SURFACE;
   EGLContext context_ = EGL_NO_CONTEXT;
@@ -130,6 +183,14 @@ class EglContext : public GlContext {
 }  // namespace
 
 std::unique_ptr<GlContext> create_gl_context(RenderBackend backend) {
+  const RenderBackend other =
+      backend == RenderBackend::kOsmesa ? RenderBackend::kEgl : RenderBackend::kOsmesa;
+  if (g_live_contexts[static_cast<int>(other)].load() > 0)
+    throw UserError(fmt::format(
+        "render.backend {}: a renderer of backend {} is still alive in this process; OSMesa and "
+        "EGL contexts share Mesa's dispatch and cannot be mixed (the first one's frames come out "
+        "wrong). Destroy the other renderers first, or use one backend per process",
+        yaml::enum_name(backend), yaml::enum_name(other)));
   switch (backend) {
     case RenderBackend::kOsmesa:
       return std::make_unique<OsmesaContext>();
