@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <memory>
 #include <utility>
 
@@ -16,6 +17,15 @@ namespace {
 
 // Coarsest level side below which the alignment has too little to work with.
 constexpr int kMinLevelSidePx = 8;
+
+// What aligning the current image to the previous pair's reference gave, kept aside until the
+// current pair's reference is done too.
+struct AlignOutcome {
+  bool ran = false;
+  dense::AlignSummary summary;
+  SE3 T_curr_prev;
+  double ms = 0.0;
+};
 
 }  // namespace
 
@@ -66,6 +76,30 @@ struct DenseStereoOdometry::Impl {
     align.robust = o.use_robust_weights();
     align.t_dof = o.t_dof;
     align.inlier_residual = o.inlier_residual_grey;
+  }
+
+  // Stereo correspondence (SGBM disparity of the pair, refined) and Eq. (1)'s points and
+  // Jacobians of `f`, the reference of the next call.
+  void prepare_reference(const StereoFrame& frame, FrameData* f) {
+    auto t = SteadyClock::now();
+    stereo->compute(frame.left, frame.right, f->pyramid.images.back(), &f->disparity);
+    stats.sgbm_ms = ms_since(t);
+    t = SteadyClock::now();
+    dense::build_reference(f->pyramid, f->disparity, rig.camera.fx * rig.baseline_m, selection,
+                           &f->ref);
+    stats.reference_ms = ms_since(t);
+  }
+
+  // Step 2: the current image `f` aligned to the previous pair's reference, from the
+  // constant-velocity prior where there is one.
+  AlignOutcome align_to_previous(const FrameData& f) {
+    const auto t = SteadyClock::now();
+    AlignOutcome out;
+    out.ran = true;
+    out.T_curr_prev = options.use_constant_velocity() && has_velocity ? last_T_curr_prev : SE3();
+    out.summary = aligner.align(prev->ref, f.pyramid, align, &out.T_curr_prev);
+    out.ms = ms_since(t);
+    return out;
   }
 
   StereoRig rig;
@@ -142,20 +176,26 @@ VoResult DenseStereoOdometry::process(const StereoFrame& frame) {
   s.stats.pyramid_ms = ms_since(t);
   result.times.detect_ms = s.stats.pyramid_ms;
 
-  // Stereo correspondence: SGBM disparity of the current pair (refined).
-  t = SteadyClock::now();
-  s.stereo->compute(frame.left, frame.right, cur.pyramid.images.back(), &cur.disparity);
-  s.stats.sgbm_ms = ms_since(t);
-  result.times.match_ms = s.stats.sgbm_ms;
-
-  // Eq. (1) points and Jacobians of the current pair, for the next call; its statistics now.
-  t = SteadyClock::now();
-  dense::build_reference(cur.pyramid, cur.disparity, s.rig.camera.fx * s.rig.baseline_m,
-                         s.selection, &cur.ref);
-  s.stats.reference_ms = ms_since(t);
+  // The current pair's disparity and reference (for the next call) on a second thread, while
+  // this one aligns the current image to the previous reference: both only read the current
+  // pyramid and write apart, so the bytes are those of doing the two in turn. The alignment
+  // runs whenever the previous pair allows it; the checks below, in the serial order, decide
+  // whether its result is used.
+  std::future<void> reference =
+      std::async(std::launch::async, [&s, &cur, &frame] { s.prepare_reference(frame, &cur); });
+  AlignOutcome aligned;
+  try {
+    if (s.has_previous && s.prev->ref.textured_depth_pixels >= s.options.min_textured_pixels)
+      aligned = s.align_to_previous(cur);
+  } catch (...) {
+    reference.wait();
+    throw;
+  }
+  reference.get();
   s.stats.valid_depth_pixels = cur.ref.valid_depth_pixels;
   s.stats.textured_pixels = cur.ref.textured_pixels;
   s.stats.textured_depth_pixels = cur.ref.textured_depth_pixels;
+  result.times.match_ms = s.stats.sgbm_ms;
 
   // Whatever happens below, this pair is the next call's reference.
   struct Advance {
@@ -184,15 +224,11 @@ VoResult DenseStereoOdometry::process(const StereoFrame& frame) {
   s.stats.reference_points = static_cast<int>(prev.ref.levels.back().size());
   if (cur.ref.textured_pixels < s.options.min_textured_pixels)
     return finish("too little texture in the current left image (black, flat or water?)");
-  if (prev.ref.textured_depth_pixels < s.options.min_textured_pixels)
-    return finish("too few textured pixels with valid depth in the previous frame");
+  if (!aligned.ran) return finish("too few textured pixels with valid depth in the previous frame");
 
-  // Step 2: Levenberg-Marquardt on Eq. (9), coarse to fine.
-  t = SteadyClock::now();
-  SE3 T_curr_prev =
-      s.options.use_constant_velocity() && s.has_velocity ? s.last_T_curr_prev : SE3();
-  const dense::AlignSummary a = s.aligner.align(prev.ref, cur.pyramid, s.align, &T_curr_prev);
-  s.stats.align_ms = ms_since(t);
+  // Step 2 (Levenberg-Marquardt on Eq. (9), coarse to fine) ran beside the reference.
+  const dense::AlignSummary& a = aligned.summary;
+  s.stats.align_ms = aligned.ms;
   s.stats.iterations = a.iterations;
   s.stats.rms_residual_grey = a.rms_residual;
   s.stats.sigma_grey = a.sigma;
@@ -203,14 +239,14 @@ VoResult DenseStereoOdometry::process(const StereoFrame& frame) {
       a.textured_inliers < s.options.min_inlier_fraction * a.textured_used)
     return finish("photometric residuals too large: the images do not align");
 
-  const SE3 T_prev_curr = T_curr_prev.inverse();
+  const SE3 T_prev_curr = aligned.T_curr_prev.inverse();
   if (!detail::is_finite(T_prev_curr) || !std::isfinite(a.mean_inlier_depth_m))
     return finish("motion estimate not finite");
   result.valid = true;
   result.T_prev_curr = T_prev_curr;
   result.mean_inlier_depth_m = a.mean_inlier_depth_m;
   s.has_velocity = true;
-  s.last_T_curr_prev = T_curr_prev;
+  s.last_T_curr_prev = aligned.T_curr_prev;
   result.times.estimate_ms = s.stats.reference_ms + s.stats.align_ms;
   result.times.total_ms = ms_since(t_start);
   return result;
