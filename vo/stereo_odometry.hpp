@@ -20,11 +20,13 @@ struct StereoFrame {
   cv::Mat right;    ///< rectified right image, CV_8UC1
 };
 
-/// Wall-clock time of the stages of one process() call [ms].
+/// Wall-clock time of the stages of one process() call [ms]. Detection comes first; matching
+/// and estimation may run side by side (the dense VO computes the new pair's disparity while it
+/// aligns to the previous pair), so total_ms >= detect_ms + max(match_ms, estimate_ms).
 struct VoStageTimes {
   double detect_ms = 0.0;    ///< feature detection / image preparation of the new pair
-  double match_ms = 0.0;     ///< correspondence search
-  double estimate_ms = 0.0;  ///< motion estimation (RANSAC, Gauss-Newton)
+  double match_ms = 0.0;     ///< correspondence search (dense: disparity and reference points)
+  double estimate_ms = 0.0;  ///< motion estimation (RANSAC, Gauss-Newton; dense: alignment)
   double total_ms = 0.0;     ///< the whole call
 };
 
