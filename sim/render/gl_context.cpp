@@ -12,6 +12,7 @@
 
 #include <array>
 #include <atomic>
+#include <mutex>
 #include <vector>
 
 #include "core/error.hpp"
@@ -49,6 +50,7 @@ class LiveCount {
 
 void load_gl_functions(GLADloadfunc loader, const char* backend) {
   if (g_loaded_by.load() == loader) return;
+  g_loaded_by.store(nullptr);  // a load that fails half way leaves no backend's pointers
   if (!gladLoadGL(loader))
     throw UserError(fmt::format("render.backend {}: loading the OpenGL functions failed", backend));
   g_loaded_by.store(loader);
@@ -74,7 +76,12 @@ class OsmesaContext : public GlContext {
           "render.backend osmesa: OSMesaCreateContextAttribs failed to create an OpenGL 4.5 "
           "core profile context (is Mesa's libOSMesa 22 or newer installed? scripts/setup-deps "
           "installs it)");
-    make_current();
+    try {
+      make_current();
+    } catch (...) {
+      OSMesaDestroyContext(ctx_);  // the destructor does not run for a throwing constructor
+      throw;
+    }
     description_ = gl_description();
   }
   ~OsmesaContext() override {
@@ -127,6 +134,26 @@ class EglContext : public GlContext {
  public:
   EglContext() {
     display_ = open_display();
+    try {
+      create_context();
+    } catch (...) {
+      release();  // the destructor does not run for a throwing constructor
+      throw;
+    }
+    description_ = gl_description();
+  }
+  ~EglContext() override { release(); }
+  void make_current() override {
+    if (!eglMakeCurrent(display_, surface_, surface_, context_))
+      throw UserError(fmt::format("render.backend egl: eglMakeCurrent failed (EGL error 0x{:x})",
+                                  eglGetError()));
+    load_gl_functions(reinterpret_cast<GLADloadfunc>(eglGetProcAddress), "egl");
+  }
+
+ private:
+  // A 4.5 core context on display_, with a 1x1 pbuffer or (where there is no pbuffer config)
+  // no surface, made current.
+  void create_context() {
     if (!eglBindAPI(EGL_OPENGL_API))
       throw UserError("render.backend egl: the EGL implementation has no desktop OpenGL API");
     const EGLint config_attribs[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE,
@@ -139,7 +166,9 @@ class EglContext : public GlContext {
     } else {
       // No pbuffer configs (some GPU device displays): all drawing goes to framebuffer objects
       // anyway, so a context without any surface (EGL_KHR_surfaceless_context) will do.
-      const EGLint any_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+      // EGL_SURFACE_TYPE defaults to EGL_WINDOW_BIT, which such displays lack as well.
+      const EGLint any_attribs[] = {EGL_SURFACE_TYPE, EGL_DONT_CARE, EGL_RENDERABLE_TYPE,
+                                    EGL_OPENGL_BIT, EGL_NONE};
       if (!eglChooseConfig(display_, any_attribs, &config, 1, &n) || n < 1)
         throw UserError("render.backend egl: no EGL config with desktop OpenGL support");
     }
@@ -156,24 +185,16 @@ class EglContext : public GlContext {
           "render.backend egl: creating an OpenGL 4.5 core context failed (EGL error 0x{:x})",
           eglGetError()));
     make_current();
-    description_ = gl_description();
   }
-  ~EglContext() override {
-    if (display_ != EGL_NO_DISPLAY) {
-      eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-      if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
-      if (surface_ != EGL_NO_SURFACE) eglDestroySurface(display_, surface_);
-      eglTerminate(display_);
-    }
-  }
-  void make_current() override {
-    if (!eglMakeCurrent(display_, surface_, surface_, context_))
-      throw UserError(fmt::format("render.backend egl: eglMakeCurrent failed (EGL error 0x{:x})",
-                                  eglGetError()));
-    load_gl_functions(reinterpret_cast<GLADloadfunc>(eglGetProcAddress), "egl");
+  void release() {
+    if (display_ == EGL_NO_DISPLAY) return;
+    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
+    if (surface_ != EGL_NO_SURFACE) eglDestroySurface(display_, surface_);
+    eglTerminate(display_);
+    display_ = EGL_NO_DISPLAY;
   }
 
- private:
   LiveCount live_{RenderBackend::kEgl};
   EGLDisplay display_ = EGL_NO_DISPLAY;
   EGLSurface surface_ = EGL_NO_SURFACE;
@@ -183,6 +204,9 @@ class EglContext : public GlContext {
 }  // namespace
 
 std::unique_ptr<GlContext> create_gl_context(RenderBackend backend) {
+  // The check and the creation as one step, so that two threads cannot mix backends either.
+  static std::mutex creating;
+  const std::lock_guard<std::mutex> lock(creating);
   const RenderBackend other =
       backend == RenderBackend::kOsmesa ? RenderBackend::kEgl : RenderBackend::kOsmesa;
   if (g_live_contexts[static_cast<int>(other)].load() > 0)

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <memory>
 #include <numbers>
+#include <string>
 
 #include "core/error.hpp"
 #include "core/rng.hpp"
@@ -118,51 +119,63 @@ TEST(Projection, MapsPixelCentresToNdc) {
 
 // One suite for both backends (OSMesa, EGL): the same geometry, depth and determinism
 // expectations hold for each. EGL is Mesa's llvmpipe on a machine without a GPU and the
-// vendor's driver on one; a machine with no EGL display at all skips it, saying why.
-class RenderTest : public ::testing::TestWithParam<RenderBackend> {
- protected:
-  void SetUp() override {
-    const RenderBackend backend = GetParam();
-#if defined(__SANITIZE_ADDRESS__)
-    // See Render.EglBackendWorksOrSaysWhy.
-    if (backend == RenderBackend::kEgl)
-      GTEST_SKIP() << "EGL under AddressSanitizer: Mesa's unloaded DRI driver leaks its globals";
-#endif
-    // One backend alive at a time: OSMesa and EGL cannot share a process (see
-    // Render.MixingBackendsIsAClearError).
-    renderers()[1 - static_cast<int>(backend)].reset();
-    std::unique_ptr<StereoRenderer>& slot = renderers()[static_cast<int>(backend)];
-    if (!slot) {
-      RenderOptions o;
-      o.msaa_samples = 4;
-      o.backend = backend;
-      try {
-        slot = std::make_unique<StereoRenderer>(rig_640(), o);
-      } catch (const UserError& e) {
-        if (backend == RenderBackend::kEgl) GTEST_SKIP() << e.what();
-        throw;
-      }
-      std::cout << slot->context_description() << "\n";
-    }
-    renderer_ = slot.get();
+// vendor's driver on one; a machine with no EGL display at all skips it, saying why. A typed
+// suite, so that each backend's tests run together with one renderer, destroyed before the
+// other backend's suite starts: OSMesa and EGL cannot share a process (see
+// Render.MixingBackendsIsAClearError).
+template <RenderBackend B>
+struct BackendIs {
+  static constexpr RenderBackend value = B;
+};
+using BackendTypes =
+    ::testing::Types<BackendIs<RenderBackend::kOsmesa>, BackendIs<RenderBackend::kEgl>>;
+struct BackendName {
+  template <class T>
+  static std::string GetName(int) {
+    return T::value == RenderBackend::kOsmesa ? "osmesa" : "egl";
   }
-  static void TearDownTestSuite() {
-    for (auto& r : renderers()) r.reset();
-  }
-  static std::array<std::unique_ptr<StereoRenderer>, 2>& renderers() {
-    static std::array<std::unique_ptr<StereoRenderer>, 2> r;
-    return r;
-  }
-  StereoRenderer* renderer_ = nullptr;
 };
 
-TEST_P(RenderTest, MarkerLandsOnItsPinholeProjectionInBothImages) {
+template <class T>
+class RenderTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+#if defined(__SANITIZE_ADDRESS__)
+    // See Render.EglBackendWorksOrSaysWhy.
+    if (T::value == RenderBackend::kEgl) {
+      skip_reason_ = "EGL under AddressSanitizer: Mesa's unloaded DRI driver leaks its globals";
+      return;
+    }
+#endif
+    RenderOptions o;
+    o.msaa_samples = 4;
+    o.backend = T::value;
+    try {
+      shared_ = std::make_unique<StereoRenderer>(rig_640(), o);
+      std::cout << shared_->context_description() << "\n";
+    } catch (const UserError& e) {
+      if (T::value != RenderBackend::kEgl) throw;
+      skip_reason_ = e.what();
+    }
+  }
+  static void TearDownTestSuite() { shared_.reset(); }
+  void SetUp() override {
+    if (!shared_) GTEST_SKIP() << skip_reason_;
+    renderer_ = shared_.get();
+  }
+  static inline std::unique_ptr<StereoRenderer> shared_;
+  static inline std::string skip_reason_;
+  StereoRenderer* renderer_ = nullptr;
+};
+TYPED_TEST_SUITE(RenderTest, BackendTypes, BackendName);
+
+TYPED_TEST(RenderTest, MarkerLandsOnItsPinholeProjectionInBothImages) {
   SceneGeometry s = dark_scene();
   const Vec3 marker(10.0, 0.7, -0.3);  // north, east, down
   s.meshes.push_back(disc(marker, 0.06));
-  renderer_->upload(s);
+  this->renderer_->upload(s);
   const SE3 T_W_C = camera_at(Vec3::Zero());
-  const StereoImages img = renderer_->render(T_W_C, 0.0, false);
+  const StereoImages img = this->renderer_->render(T_W_C, 0.0, false);
   const StereoRig rig = rig_640();
   const Vec3 p_C = T_W_C.inverse() * marker;
   const Eigen::Vector2d uv = rig.camera.project(p_C);
@@ -178,7 +191,7 @@ TEST_P(RenderTest, MarkerLandsOnItsPinholeProjectionInBothImages) {
             << "), disparity " << cl.x() - cr.x() << " vs " << 6.0 << "\n";
 }
 
-TEST_P(RenderTest, GroundTruthDepthOfAWallIsItsDistance) {
+TYPED_TEST(RenderTest, GroundTruthDepthOfAWallIsItsDistance) {
   SceneGeometry s = dark_scene();
   Mesh wall;
   wall.name = "wall";
@@ -189,20 +202,20 @@ TEST_P(RenderTest, GroundTruthDepthOfAWallIsItsDistance) {
                    {x, -50, 30, -1, 0, 0, 0, 1}};
   wall.indices = {0, 1, 2, 0, 2, 3};
   s.meshes.push_back(wall);
-  renderer_->upload(s);
-  const StereoImages img = renderer_->render(camera_at(Vec3(0, 0, 0)), 0.0, true);
+  this->renderer_->upload(s);
+  const StereoImages img = this->renderer_->render(camera_at(Vec3(0, 0, 0)), 0.0, true);
   ASSERT_EQ(img.depth_left.width, 640);
   double worst = 0;
   for (float d : img.depth_left.depth_m) worst = std::max(worst, std::abs(d - 20.0));
   EXPECT_LT(worst, 1e-3);
 }
 
-TEST_P(RenderTest, RepeatedRendersAreByteIdentical) {
-  renderer_->upload(checker_disc_over_water(Vec3(8, 1, -1), 1.5, 40, 200));
+TYPED_TEST(RenderTest, RepeatedRendersAreByteIdentical) {
+  this->renderer_->upload(checker_disc_over_water(Vec3(8, 1, -1), 1.5, 40, 200));
   WaveComponent w{0.02, 2 * std::numbers::pi / 1.5, 3.0, 0.3, 0.1};
-  renderer_->set_waves({w});
-  const StereoImages a = renderer_->render(camera_at(Vec3(0, 0, -0.5)), 1.25, true);
-  const StereoImages b = renderer_->render(camera_at(Vec3(0, 0, -0.5)), 1.25, true);
+  this->renderer_->set_waves({w});
+  const StereoImages a = this->renderer_->render(camera_at(Vec3(0, 0, -0.5)), 1.25, true);
+  const StereoImages b = this->renderer_->render(camera_at(Vec3(0, 0, -0.5)), 1.25, true);
   EXPECT_EQ(a.left.pixels, b.left.pixels);
   EXPECT_EQ(a.right.pixels, b.right.pixels);
   EXPECT_EQ(a.depth_left.depth_m, b.depth_left.depth_m);
@@ -210,26 +223,26 @@ TEST_P(RenderTest, RepeatedRendersAreByteIdentical) {
   int lower_nonzero = 0;
   for (int x = 0; x < 640; ++x) lower_nonzero += a.left.at(x, 470) > 0;
   EXPECT_GT(lower_nonzero, 600);
-  renderer_->set_waves({});
+  this->renderer_->set_waves({});
 }
 
-TEST_P(RenderTest, WindRipplesBreakTheMirrorImageOnlyOnTheWater) {
+TYPED_TEST(RenderTest, WindRipplesBreakTheMirrorImageOnlyOnTheWater) {
   // A bright textured disc above dark water: its mirror image lies below the
   // horizon. Ripples move and blur the mirror image; the disc itself, above
   // the horizon, keeps every byte; with the ripples gone again the frame is
   // the calm frame byte for byte.
-  renderer_->upload(checker_disc_over_water(Vec3(8, 0, -1.5), 1.2, 30, 220));
-  renderer_->set_waves({});
+  this->renderer_->upload(checker_disc_over_water(Vec3(8, 0, -1.5), 1.2, 30, 220));
+  this->renderer_->set_waves({});
   const SE3 T_W_C = camera_at(Vec3(0, 0, -0.5));
-  const StereoImages calm = renderer_->render(T_W_C, 2.0, false);
+  const StereoImages calm = this->renderer_->render(T_W_C, 2.0, false);
   WindOptions w;
   w.speed_mps = 3.0;
-  renderer_->set_ripples(wind_ripples(w, RngStreams(3).stream("water.ripples")));
-  const StereoImages rippled = renderer_->render(T_W_C, 2.0, false);
-  const StereoImages later = renderer_->render(T_W_C, 2.5, false);
-  const StereoImages rippled_again = renderer_->render(T_W_C, 2.0, false);
-  renderer_->set_ripples({});
-  const StereoImages calm_again = renderer_->render(T_W_C, 2.0, false);
+  this->renderer_->set_ripples(wind_ripples(w, RngStreams(3).stream("water.ripples")));
+  const StereoImages rippled = this->renderer_->render(T_W_C, 2.0, false);
+  const StereoImages later = this->renderer_->render(T_W_C, 2.5, false);
+  const StereoImages rippled_again = this->renderer_->render(T_W_C, 2.0, false);
+  this->renderer_->set_ripples({});
+  const StereoImages calm_again = this->renderer_->render(T_W_C, 2.0, false);
   EXPECT_EQ(calm.left.pixels, calm_again.left.pixels);
   EXPECT_EQ(rippled.left.pixels, rippled_again.left.pixels);
   // Rows 0..239 look above the horizon (row 239.5 is level with the camera):
@@ -262,12 +275,6 @@ TEST_P(RenderTest, WindRipplesBreakTheMirrorImageOnlyOnTheWater) {
   EXPECT_GT(calm_contrast, 10.0);
   EXPECT_GT(rippled_contrast, calm_contrast / 3);
 }
-
-INSTANTIATE_TEST_SUITE_P(Backends, RenderTest,
-                         ::testing::Values(RenderBackend::kOsmesa, RenderBackend::kEgl),
-                         [](const ::testing::TestParamInfo<RenderBackend>& info) {
-                           return info.param == RenderBackend::kOsmesa ? "osmesa" : "egl";
-                         });
 
 // Largest error of the x shift of a small bright disc's mirror image on the
 // water as the camera steps sideways in tenths of a pixel of image motion,
