@@ -695,6 +695,66 @@ TEST(DenseVoTest, RejectsABadReferenceOrTargetWithAReason) {
   EXPECT_TRUE(r2.T_prev_curr.translation().isZero(0.0));
 }
 
+// The VO computes the current pair's disparity and reference on a second thread while it aligns
+// the current image to the previous reference. The same components run in turn by hand, in the
+// serial order of the paper's two steps, must give the same bytes: threading may not change a
+// result. The turning sequence with the shipped options (constant-velocity prior included).
+TEST(DenseVoTest, ThreadedFrameMatchesTheComponentsRunInTurn) {
+  const Sequence& seq = turn_640();
+  const DenseVoOptions o;
+  DenseStereoOdometry vo(seq.rig, o, vo_rng());
+  dense::DisparityEstimator stereo(dense::disparity_options(o));
+  const dense::RefSelection selection = dense::ref_selection(o);
+  const dense::AlignOptions align = dense::align_options(o);
+  dense::Aligner aligner;
+  struct Pair {
+    dense::Pyramid pyramid;
+    cv::Mat disparity;
+    dense::Reference ref;
+  } pairs[2];
+  for (Pair& p : pairs) p.pyramid.configure(seq.rig.camera, o.pyramid_scales);
+  bool has_velocity = false;
+  SE3 last_T_curr_prev;
+  int compared = 0;
+  for (std::size_t k = 0; k < seq.frames.size(); ++k) {
+    const StereoFrame& f = seq.frames[k];
+    Pair& cur = pairs[k % 2];
+    const Pair& prev = pairs[(k + 1) % 2];
+    cur.pyramid.build(f.left, o.pyramid_blur_sigma_px, o.pyramid_area_downscaling);
+    // Step 2 before step 1 of this pair: the alignment only reads the previous reference.
+    SE3 T_curr_prev = o.use_constant_velocity() && has_velocity ? last_T_curr_prev : SE3();
+    dense::AlignSummary a;
+    const bool aligned = k > 0 && prev.ref.textured_depth_pixels >= o.min_textured_pixels;
+    if (aligned) a = aligner.align(prev.ref, cur.pyramid, align, &T_curr_prev);
+    stereo.compute(f.left, f.right, cur.pyramid.images.back(), &cur.disparity);
+    dense::build_reference(cur.pyramid, cur.disparity, seq.rig.camera.fx * seq.rig.baseline_m,
+                           selection, &cur.ref);
+    const bool valid = aligned && cur.ref.textured_pixels >= o.min_textured_pixels && a.ok &&
+                       a.textured_inliers >= o.min_textured_pixels &&
+                       a.textured_inliers >= o.min_inlier_fraction * a.textured_used;
+    has_velocity = valid;
+    if (valid) last_T_curr_prev = T_curr_prev;
+
+    const VoResult r = vo.process(f);
+    ASSERT_EQ(r.valid, valid) << "frame " << k << ": " << r.reason;
+    EXPECT_EQ(vo.last_stats().valid_depth_pixels, cur.ref.valid_depth_pixels) << "frame " << k;
+    if (!valid) continue;
+    ++compared;
+    VoResult by_hand;
+    by_hand.T_prev_curr = T_curr_prev.inverse();
+    by_hand.mean_inlier_depth_m = a.mean_inlier_depth_m;
+    by_hand.matches = a.used;
+    by_hand.inliers = a.inliers;
+    std::vector<double> x, y;
+    test::append_result_bytes(r, &x);
+    test::append_result_bytes(by_hand, &y);
+    ASSERT_EQ(x.size(), y.size());
+    EXPECT_EQ(std::memcmp(x.data(), y.data(), x.size() * sizeof(double)), 0) << "frame " << k;
+    EXPECT_EQ(r.valid_depth_pixels, prev.ref.valid_depth_pixels) << "frame " << k;
+  }
+  EXPECT_EQ(compared, static_cast<int>(seq.frames.size()) - 1);
+}
+
 TEST(DenseVoTest, DeterministicAcrossInstancesResetAndOpenCvThreadCounts) {
   const Sequence& seq = turn_640();
   auto run_bytes = [&](DenseStereoOdometry& vo) {

@@ -51,6 +51,26 @@ DisparityOptions disparity_options(const DenseVoOptions& o) {
   return d;
 }
 
+RefSelection ref_selection(const DenseVoOptions& o) {
+  RefSelection s;
+  s.min_disparity_px = o.min_disparity_px;
+  s.gradient_mask = o.use_gradient_mask();
+  s.min_gradient = o.min_gradient_grey_per_px;
+  s.lower_mask_fraction = o.effective_lower_mask();
+  return s;
+}
+
+AlignOptions align_options(const DenseVoOptions& o) {
+  AlignOptions a;
+  a.max_iterations = o.pyramid_max_iterations;
+  a.initial_lambda = o.lm_initial_lambda;
+  a.step_tolerance = o.lm_step_tolerance;
+  a.robust = o.use_robust_weights();
+  a.t_dof = o.t_dof;
+  a.inlier_residual = o.inlier_residual_grey;
+  return a;
+}
+
 }  // namespace dense
 
 struct DenseStereoOdometry::Impl {
@@ -62,20 +82,12 @@ struct DenseStereoOdometry::Impl {
   };
 
   Impl(const StereoRig& rig_in, const DenseVoOptions& options_in)
-      : rig(rig_in), options(options_in) {
-    const DenseVoOptions& o = options;
-    stereo = std::make_unique<dense::DisparityEstimator>(dense::disparity_options(o));
-    for (FrameData* f : {&a, &b}) f->pyramid.configure(rig.camera, o.pyramid_scales);
-    selection.min_disparity_px = o.min_disparity_px;
-    selection.gradient_mask = o.use_gradient_mask();
-    selection.min_gradient = o.min_gradient_grey_per_px;
-    selection.lower_mask_fraction = o.effective_lower_mask();
-    align.max_iterations = o.pyramid_max_iterations;
-    align.initial_lambda = o.lm_initial_lambda;
-    align.step_tolerance = o.lm_step_tolerance;
-    align.robust = o.use_robust_weights();
-    align.t_dof = o.t_dof;
-    align.inlier_residual = o.inlier_residual_grey;
+      : rig(rig_in),
+        options(options_in),
+        stereo(std::make_unique<dense::DisparityEstimator>(dense::disparity_options(options_in))),
+        selection(dense::ref_selection(options_in)),
+        align(dense::align_options(options_in)) {
+    for (FrameData* f : {&a, &b}) f->pyramid.configure(rig.camera, options.pyramid_scales);
   }
 
   // Stereo correspondence (SGBM disparity of the pair, refined) and Eq. (1)'s points and

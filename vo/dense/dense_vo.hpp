@@ -44,6 +44,7 @@
 #include "core/rng.hpp"
 #include "vo/dense/dense_options.hpp"
 #include "vo/dense/disparity.hpp"
+#include "vo/dense/photometric.hpp"
 #include "vo/stereo_odometry.hpp"
 
 namespace driftlab::vo {
@@ -51,6 +52,10 @@ namespace driftlab::vo {
 namespace dense {
 /// The disparity estimator's settings that a dense VO with these options uses.
 DisparityOptions disparity_options(const DenseVoOptions& options);
+/// Which reference pixels a dense VO with these options keeps.
+RefSelection ref_selection(const DenseVoOptions& options);
+/// The alignment settings of a dense VO with these options.
+AlignOptions align_options(const DenseVoOptions& options);
 }  // namespace dense
 
 /// Details of the last process() call, for diagnostics, tests and benchmarks.
