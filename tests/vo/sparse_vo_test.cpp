@@ -81,7 +81,7 @@ TEST(SparseVoOptionsTest, DefaultsAreThePapersValues) {
   EXPECT_EQ(o.ransac_iterations, 50);       // "50 times"
   EXPECT_EQ(o.ransac_sample_size, 3);       // "three randomly-selected matches"
   EXPECT_TRUE(o.final_refinement);          // "used in a final optimisation"
-  EXPECT_EQ(o.inlier_threshold_px, 2.0);    // libviso2's default (documented)
+  EXPECT_EQ(o.inlier_threshold_px, 1.0);    // ours, not libviso2's 2 px (documented)
   EXPECT_EQ(yaml::validate(o), "");
 }
 
