@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <future>
 #include <limits>
@@ -420,6 +421,78 @@ TEST(SparseMotionTest, RansacFindsTheMotionAmongOutliers) {
     EXPECT_LT(std::max(el, er), 2.0 + 1.0);
   }
   EXPECT_GT(r.inliers->size(), 120u);
+}
+
+// What the default inlier threshold is for (sparse_options.hpp): the river paper's slow boat
+// seen by its Bumblebee2 (1024x768, f = 817 px, 0.12 m), 2.3 cm a frame sideways and forwards,
+// features 8-50 m away moving 0.4-2.4 px, matched to 0.05 px; and 2 % of stereo matches on
+// horizontal edges at a wrong disparity of 28 px (they look 3.5 m away but move like the far
+// scene). Within libviso2's 2 px, a turn without translation fits every match, wrong ones
+// included, better than the true motion (which rejects the wrong ones), so RANSAC takes it; the
+// 1 px default tells them apart. The true motion is the independent expectation.
+TEST(SparseMotionTest, SubPixelMotionWithWrongDisparitiesNeedsTheDefaultThreshold) {
+  StereoRig rig;
+  rig.camera.fx = rig.camera.fy = 817.0;
+  rig.camera.cx = 511.5;
+  rig.camera.cy = 383.5;
+  rig.camera.width = 1024;
+  rig.camera.height = 768;
+  rig.baseline_m = 0.12;
+  const SE3 T_prev_curr = SE3::from_translation(Vec3(-0.020, 0.0, 0.012));
+  const SE3 truth = T_prev_curr.inverse();
+  auto matches = [&](std::uint64_t seed) {
+    Rng rng(seed);
+    std::vector<StereoPointMatch> out;
+    while (out.size() < 400) {
+      const double z = rng.uniform(8, 50);
+      const Vec3 p(rng.uniform(-0.6, 0.6) * z, rng.uniform(-0.45, 0.45) * z, z);
+      const Vec3 c = truth * p;
+      const Eigen::Vector2d l = rig.camera.project(c), r = rig.project_right(c);
+      if (!rig.camera.in_image(l) || !rig.camera.in_image(r)) continue;
+      StereoPointMatch m;
+      m.p_prev = p;
+      m.u_l = l.x() + 0.05 * rng.normal();
+      m.v_l = l.y() + 0.05 * rng.normal();
+      m.u_r = r.x() + 0.05 * rng.normal();
+      m.v_r = m.v_l;
+      if (out.size() % 50 == 0) {  // a wrong disparity of 28 px, in both frames
+        const Eigen::Vector2d l_prev = rig.camera.project(p);
+        m.p_prev = rig.triangulate(l_prev, 28.0);
+        m.u_r = m.u_l - 28.0;
+      }
+      out.push_back(m);
+    }
+    return out;
+  };
+  SparseVoOptions libviso2;
+  libviso2.inlier_threshold_px = 2.0;
+  int failed_default = 0, failed_libviso2 = 0;
+  double worst_default_m = 0.0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const auto m = matches(seed);
+    for (const SparseVoOptions& o : {SparseVoOptions{}, libviso2}) {
+      StereoMotionEstimator est(rig, o);
+      Rng rng(100 + seed);
+      const auto r = est.estimate(m, &rng);
+      ASSERT_TRUE(r.ok) << r.failure;
+      const double error_m =
+          (r.T_curr_prev.inverse().translation() - T_prev_curr.translation()).norm();
+      const bool failed = error_m > 0.25 * T_prev_curr.translation().norm();
+      if (o.inlier_threshold_px == SparseVoOptions{}.inlier_threshold_px) {
+        failed_default += failed ? 1 : 0;
+        worst_default_m = std::max(worst_default_m, error_m);
+      } else {
+        failed_libviso2 += failed ? 1 : 0;
+      }
+    }
+  }
+  std::printf(
+      "[ sparse   ] 20 frames, motion off by more than 25 %%: %d at 1 px (worst %.2f mm), "
+      "%d at 2 px\n",
+      failed_default, worst_default_m * 1e3, failed_libviso2);
+  EXPECT_EQ(failed_default, 0);
+  EXPECT_LT(worst_default_m, 0.1 * T_prev_curr.translation().norm());
+  EXPECT_GE(failed_libviso2, 5) << "the case no longer tells the thresholds apart";
 }
 
 TEST(SparseMotionTest, RansacReportsTooFewMatches) {
