@@ -431,13 +431,7 @@ TEST(SparseMotionTest, RansacFindsTheMotionAmongOutliers) {
 // included, better than the true motion (which rejects the wrong ones), so RANSAC takes it; the
 // 1 px default tells them apart. The true motion is the independent expectation.
 TEST(SparseMotionTest, SubPixelMotionWithWrongDisparitiesNeedsTheDefaultThreshold) {
-  StereoRig rig;
-  rig.camera.fx = rig.camera.fy = 817.0;
-  rig.camera.cx = 511.5;
-  rig.camera.cy = 383.5;
-  rig.camera.width = 1024;
-  rig.camera.height = 768;
-  rig.baseline_m = 0.12;
+  const StereoRig rig = test::bumblebee2_rig();
   const SE3 T_prev_curr = SE3::from_translation(Vec3(-0.020, 0.0, 0.012));
   const SE3 truth = T_prev_curr.inverse();
   auto matches = [&](std::uint64_t seed) {

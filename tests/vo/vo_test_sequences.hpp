@@ -38,29 +38,28 @@
 
 namespace driftlab::vo::test {
 
-/// KITTI-like rig: 1241x376, fx = fy = 718.856, principal point (607.19, 185.22), B = 0.537 m.
-inline StereoRig kitti_rig() {
+/// A rectified rig with square pixels: width x height px, focal length f [px], principal point
+/// (cx, cy) [px], baseline [m].
+inline StereoRig make_rig(int width, int height, double f, double cx, double cy, double baseline) {
   StereoRig rig;
-  rig.camera.fx = rig.camera.fy = 718.856;
-  rig.camera.cx = 607.1928;
-  rig.camera.cy = 185.2157;
-  rig.camera.width = 1241;
-  rig.camera.height = 376;
-  rig.baseline_m = 0.537;
+  rig.camera.fx = rig.camera.fy = f;
+  rig.camera.cx = cx;
+  rig.camera.cy = cy;
+  rig.camera.width = width;
+  rig.camera.height = height;
+  rig.baseline_m = baseline;
   return rig;
 }
 
+/// The river paper's Bumblebee2 (the `bumblebee2` camera preset): 1024x768, fx = fy = 817,
+/// B = 0.12 m.
+inline StereoRig bumblebee2_rig() { return make_rig(1024, 768, 817.0, 511.5, 383.5, 0.12); }
+
+/// KITTI-like rig: 1241x376, fx = fy = 718.856, principal point (607.19, 185.22), B = 0.537 m.
+inline StereoRig kitti_rig() { return make_rig(1241, 376, 718.856, 607.1928, 185.2157, 0.537); }
+
 /// Bumblebee2-like rig of the river paper: 640x480, fx = fy = 500, centred, B = 0.12 m.
-inline StereoRig rig_640x480() {
-  StereoRig rig;
-  rig.camera.fx = rig.camera.fy = 500.0;
-  rig.camera.cx = 319.5;
-  rig.camera.cy = 239.5;
-  rig.camera.width = 640;
-  rig.camera.height = 480;
-  rig.baseline_m = 0.12;
-  return rig;
-}
+inline StereoRig rig_640x480() { return make_rig(640, 480, 500.0, 319.5, 239.5, 0.12); }
 
 enum class Surface { kTexture, kWater };
 
