@@ -127,8 +127,9 @@ struct StereoRenderer::Impl {
   float wave_amplitude_sum_m = 0;
   std::vector<float> wave_a;  // 4 per component
   std::vector<float> wave_phase;
-  std::vector<float> ripple_a;  // 4 per ripple: kx, ky, omega, slope amplitude
-  std::vector<float> ripple_phase;
+  std::vector<WaveComponent> ripples;  // longest first
+  std::vector<float> ripple_a;         // 4 per ripple: kx, ky, a kx / |k|, a ky / |k|
+  std::vector<float> ripple_scale;     // 3 per ripple: wavelength, (a k)^2 / 2, its suffix sum
   int refl_levels = 1;
   int refl_width = 0, refl_height = 0;  // the reflection pass's size
   // Framebuffers.
@@ -427,15 +428,29 @@ void StereoRenderer::set_ripples(const std::vector<WaveComponent>& components) {
   Impl& m = *impl_;
   std::vector<WaveComponent> c = components;
   if (c.size() > static_cast<std::size_t>(kMaxShaderRipples)) c.resize(kMaxShaderRipples);
+  // Longest first, so that the shader stops at the first ripple too short to
+  // resolve and takes the slope variance of the rest from the suffix sum.
+  std::stable_sort(c.begin(), c.end(), [](const WaveComponent& a, const WaveComponent& b) {
+    return a.wavenumber_rad_m < b.wavenumber_rad_m;
+  });
+  m.ripples = c;
   m.ripple_a.clear();
-  m.ripple_phase.clear();
+  m.ripple_scale.assign(3 * c.size(), 0.f);
+  double suffix = 0.0;
+  for (std::size_t i = c.size(); i-- > 0;) {
+    const double ak = c[i].amplitude_m * c[i].wavenumber_rad_m;
+    suffix += 0.5 * ak * ak;
+    m.ripple_scale[3 * i] = static_cast<float>(2.0 * std::numbers::pi / c[i].wavenumber_rad_m);
+    m.ripple_scale[3 * i + 1] = static_cast<float>(0.5 * ak * ak);
+    m.ripple_scale[3 * i + 2] = static_cast<float>(suffix);
+  }
   for (const auto& w : c) {
-    m.ripple_a.insert(m.ripple_a.end(),
-                      {static_cast<float>(w.wavenumber_rad_m * std::cos(w.direction_rad)),
-                       static_cast<float>(w.wavenumber_rad_m * std::sin(w.direction_rad)),
-                       static_cast<float>(w.omega_rad_s),
-                       static_cast<float>(w.amplitude_m * w.wavenumber_rad_m)});
-    m.ripple_phase.push_back(static_cast<float>(w.phase_rad));
+    const double kx = w.wavenumber_rad_m * std::cos(w.direction_rad),
+                 ky = w.wavenumber_rad_m * std::sin(w.direction_rad);
+    const double ak = w.amplitude_m * w.wavenumber_rad_m;
+    m.ripple_a.insert(m.ripple_a.end(), {static_cast<float>(kx), static_cast<float>(ky),
+                                         static_cast<float>(ak * std::cos(w.direction_rad)),
+                                         static_cast<float>(ak * std::sin(w.direction_rad))});
   }
   // The mirror image is sampled from its mip levels only when ripples blur it.
   m.context->make_current();
@@ -529,7 +544,7 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   if (!scene.water.enabled) return;
   const Lighting& L = scene.lighting;
   const WaterAppearance& w = scene.water;
-  const GLuint water_prog = water_progs[mode][L.sun ? 1 : 0][ripple_phase.empty() ? 0 : 1];
+  const GLuint water_prog = water_progs[mode][L.sun ? 1 : 0][ripples.empty() ? 0 : 1];
   glUseProgram(water_prog);
   set_mat4(water_prog, "u_view", view);
   set_mat4(water_prog, "u_proj", proj);
@@ -553,11 +568,17 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   glUniform1f(loc(water_prog, "u_fog"), L.fog_distance_m);
   const Eigen::Vector3f sun = L.sun_direction_W.normalized();
   glUniform3f(loc(water_prog, "u_sun_dir"), sun.x(), sun.y(), sun.z());
-  const int ripples = static_cast<int>(ripple_phase.size());
-  glUniform1i(loc(water_prog, "u_ripple_count"), ripples);
-  if (ripples > 0) {
-    glUniform4fv(loc(water_prog, "u_ripple"), ripples, ripple_a.data());
-    glUniform1fv(loc(water_prog, "u_ripple_phase"), ripples, ripple_phase.data());
+  const int n_ripples = static_cast<int>(ripples.size());
+  glUniform1i(loc(water_prog, "u_ripple_count"), n_ripples);
+  if (n_ripples > 0) {
+    // Phases at time t in double precision, reduced to [0, 2 pi).
+    std::vector<float> phase;
+    for (const WaveComponent& r : ripples)
+      phase.push_back(static_cast<float>(
+          std::remainder(r.phase_rad - r.omega_rad_s * t, 2.0 * std::numbers::pi)));
+    glUniform4fv(loc(water_prog, "u_ripple"), n_ripples, ripple_a.data());
+    glUniform3fv(loc(water_prog, "u_ripple_scale"), n_ripples, ripple_scale.data());
+    glUniform1fv(loc(water_prog, "u_ripple_phase"), n_ripples, phase.data());
   }
   glUniform2f(loc(water_prog, "u_focal"), static_cast<float>(rig.camera.fx),
               static_cast<float>(rig.camera.fy));
@@ -648,7 +669,7 @@ void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, int eye_index) {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.refl_fbo);
     glBlitFramebuffer(0, 0, RW, RH, 0, 0, RW, RH, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
-  if (!ripple_phase.empty()) {
+  if (!ripples.empty()) {
     glBindTexture(GL_TEXTURE_2D, e.refl_tex);
     glGenerateMipmap(GL_TEXTURE_2D);
   }

@@ -152,6 +152,16 @@ out vec3 v_world;
 #if SUN && !DEPTH
 out vec3 v_normal;
 #endif
+#if RIPPLES && !DEPTH
+uniform vec2 u_focal;       // fx, fy [px]
+out vec4 v_jacobian;       // d(mirror pixel)/d(slope), columns (x, y) [px]
+// Pixel position of the reflection, in the mirror image, of the ray d from the
+// eye reflected off a surface of slope s (grad eta).
+vec2 mirror_px(vec3 d, vec2 s) {
+  vec3 r = mat3(u_view) * reflect(d, normalize(vec3(-s, -1.0)));
+  return u_focal * r.xy / max(r.z, 0.05);
+}
+#endif
 void main() {
   vec2 xy = u_centre + a_grid;
   float eta = 0.0;
@@ -179,6 +189,14 @@ void main() {
 #if SUN
   v_normal = n;
 #endif
+#if RIPPLES
+  // The Jacobian of the mirror pixel in the ripple slope at the flat surface:
+  // smooth over the water, so taken once per vertex (central differences).
+  vec3 d = -v;
+  const float eps = 0.01;
+  v_jacobian = vec4(mirror_px(d, vec2(eps, 0.0)) - mirror_px(d, vec2(-eps, 0.0)),
+                    mirror_px(d, vec2(0.0, eps)) - mirror_px(d, vec2(0.0, -eps))) / (2.0 * eps);
+#endif
 #endif
   gl_Position = u_proj * c;
 }
@@ -196,11 +214,17 @@ in vec3 v_world;
 #if SUN && !DEPTH
 in vec3 v_normal;
 #endif
+#if RIPPLES && !DEPTH
+in vec4 v_jacobian;
+#endif
 const int R = 16;
-uniform vec4 u_ripple[R];       // kx, ky, omega, slope amplitude a k
+// Ripples, longest first: wave vector k; slope amplitude a k along k / |k|;
+// wavelength; half the slope variance; the latter summed over this ripple and
+// all shorter ones; phase at this frame's time.
+uniform vec4 u_ripple[R];       // kx, ky, a kx / |k|, a ky / |k|
+uniform vec3 u_ripple_scale[R]; // wavelength [m], (a k)^2 / 2, its sum from here on
 uniform float u_ripple_phase[R];
 uniform int u_ripple_count;
-uniform float u_time;
 uniform mat4 u_view;
 uniform vec2 u_focal;           // fx, fy [px]
 uniform float u_refl_max_lod;
@@ -239,11 +263,14 @@ void main() {
     vec2 slope = vec2(0.0);
     float unresolved = 0.0;
     for (int i = 0; i < u_ripple_count; ++i) {
-      vec2 k = u_ripple[i].xy;
-      float keep = smoothstep(2.0, 4.0, 6.2831853 / (length(k) * foot));
-      float th = dot(k, xy) - u_ripple[i].z * u_time + u_ripple_phase[i];
-      slope -= keep * u_ripple[i].w * sin(th) * normalize(k);
-      unresolved += (1.0 - keep * keep) * 0.5 * u_ripple[i].w * u_ripple[i].w;
+      float cycles_px = u_ripple_scale[i].x / foot;  // pixels per wavelength
+      if (cycles_px < 2.0) {  // this one and all shorter ones are unresolved
+        unresolved += u_ripple_scale[i].z;
+        break;
+      }
+      float keep = smoothstep(2.0, 4.0, cycles_px);
+      slope -= keep * sin(dot(u_ripple[i].xy, xy) + u_ripple_phase[i]) * u_ripple[i].zw;
+      unresolved += (1.0 - keep * keep) * u_ripple_scale[i].y;
     }
     // Where the reflected ray through the rippled surface lands in the
     // mirror image, against the ray through the flat surface: exact for
@@ -251,13 +278,12 @@ void main() {
     vec2 p0 = mirror_px(vec2(0.0)), p1 = mirror_px(slope);
     uv += (p1 - p0) / u_viewport;
     // The unresolved ripples spread the reflected rays: the spread of their
-    // image is J S J^T, J the Jacobian of mirror_px in the slope and S the
-    // slope covariance (isotropic). At grazing angles it is long and
+    // image is J S J^T, J the Jacobian of mirror_px in the slope (at the
+    // flat surface, from the vertex shader) and S the slope covariance
+    // (isotropic). At grazing angles it is long and
     // vertical (the streaks of a rippled reflection): the long axis is
     // sampled in five taps, the short one by the mip level.
-    const float eps = 0.01;
-    mat2 J = mat2((mirror_px(slope + vec2(eps, 0.0)) - p1) / eps,
-                  (mirror_px(slope + vec2(0.0, eps)) - p1) / eps);
+    mat2 J = mat2(v_jacobian.xy, v_jacobian.zw);
     mat2 C = 0.5 * unresolved * J * transpose(J);
     float half_tr = 0.5 * (C[0][0] + C[1][1]);
     float det = C[0][0] * C[1][1] - C[0][1] * C[1][0];
