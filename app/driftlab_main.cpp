@@ -83,6 +83,7 @@ int run_command(const std::string& file, const std::string& out_dir,
 struct EvalArgs {
   std::string gt, est, format = "tum", align = "horn", covariates, out, name, rpe_unit = "frames";
   std::string regress = "v,h,f,d";
+  std::string reference_point = "0,0,0";
   double section_length_m = 6.5;
   double length_sample_m = 0.5;
   double max_diff_s = 0.02;
@@ -129,7 +130,8 @@ int eval_command(const EvalArgs& a) {
       "association_tolerance_s=" + fmt::format("{}", a.max_diff_s),
       "rpe_delta=" + fmt::format("{}", a.rpe_delta),
       "rpe_unit=" + a.rpe_unit,
-      "regression_covariates=[" + a.regress + "]"};
+      "regression_covariates=[" + a.regress + "]",
+      "reference_point_m=[" + a.reference_point + "]"};
   for (const auto& set : sets) {
     const auto eq = set.find('=');
     driftlab::yaml::read_into(driftlab::yaml::override_document(set),
@@ -288,6 +290,11 @@ struct EvalVerb : Pinned {
     cmd->add_option("--covariates", ev.covariates,
                     "Per-frame covariates CSV (t_ns or t column; inliers, mean_depth_m, ...)");
     cmd->add_option("--regress", ev.regress, "Comma-separated regression covariates")
+        ->capture_default_str();
+    cmd->add_option("--reference-point", ev.reference_point,
+                    "Where the ground truth is measured, from the camera in its optical frame "
+                    "(x right, y down, z forward), as X,Y,Z [m]; the estimate stays the camera's "
+                    "(eval.reference_point_m)")
         ->capture_default_str();
     cmd->add_option("--name", ev.name, "Algorithm name in tables (default: estimate file stem)");
     cmd->add_option("--out", ev.out, "Output folder (written atomically)")->required();

@@ -95,6 +95,14 @@ void mark_lost_track_sections(const FrameTable* frames, Evaluation* e) {
       e->tracked_summary->p_m_per_m.mean, tracked.size()));
 }
 
+// The pose of the reference point l_C (eval.reference_point_m): the camera's orientation at
+// p_W + R_W_C l_C.
+SE3 at_reference_point(const SE3& T_W_C, const std::array<double, 3>& l_C) {
+  if (l_C == std::array<double, 3>{0.0, 0.0, 0.0}) return T_W_C;
+  return SE3(T_W_C.quaternion(),
+             T_W_C.translation() + T_W_C.quaternion() * Vec3(l_C[0], l_C[1], l_C[2]));
+}
+
 }  // namespace
 
 Evaluation evaluate(const EvaluationInput& in) {
@@ -110,7 +118,7 @@ Evaluation evaluate(const EvaluationInput& in) {
   std::vector<SE3> gt, est;
   for (std::size_t k = 0; k < e.association.size(); ++k) {
     t.push_back(in.est[e.association.est[k]].t_ns);
-    gt.push_back(in.gt[e.association.gt[k]].T_W_C);
+    gt.push_back(at_reference_point(in.gt[e.association.gt[k]].T_W_C, opt.reference_point_m));
     est.push_back(in.est[e.association.est[k]].T_W_C);
   }
   const std::size_t unpaired = in.est.size() - e.association.size();

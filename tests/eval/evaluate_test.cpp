@@ -81,6 +81,33 @@ TEST(Evaluate, ScaledEstimateGivesItsScaleErrorPerMetreAndSim3UndoesIt) {
   EXPECT_NEAR(e.track.length_error_pct, 0.0, 1e-9);  // measured after alignment
 }
 
+// The river paper's truth came from a prism the total station tracked, the estimate from the
+// camera. With the truth moved 0.8 m ahead of a level camera (eval.reference_point_m) and a
+// perfect estimate, a section's error is the lever arm's turn, (R_end - R_start) l: of length
+// 2 |l| sin(dpsi / 2) for a heading change dpsi; with the default (the camera) it is zero.
+TEST(Evaluate, ReferencePointAwayFromTheCameraTurnsHeadingChangesIntoSectionErrors) {
+  const Trajectory gt = serpentine();
+  EvaluationInput in = input_with(gt, gt);
+  const Evaluation exact = evaluate(in);
+  ASSERT_GT(exact.sections.size(), 25u);
+  EXPECT_LT(exact.section_summary.p_m_per_m.max, 1e-9);
+  in.options.reference_point_m = {0.0, 0.0, 0.8};
+  const Evaluation e = evaluate(in);
+  ASSERT_GT(e.sections.size(), 25u);
+  double largest = 0;
+  for (const auto& sec : e.sections) {
+    const double dpsi =
+        angle_between(gt[sec.first].T_W_C.quaternion(), gt[sec.last].T_W_C.quaternion());
+    EXPECT_NEAR(sec.err_p_m, 2 * 0.8 * std::sin(dpsi / 2), 1e-9) << "section " << sec.index;
+    EXPECT_NEAR(sec.err_rad.yaw_rad, 0.0, 1e-9);
+    largest = std::max(largest, sec.err_p_m);
+  }
+  EXPECT_GT(largest, 0.1);  // the serpentine turns enough for the lever arm to show
+  // The truth's positions moved, its orientations did not: the track is the prism's.
+  EXPECT_NEAR(e.ape.rot_deg.max, 0.0, 1e-7);
+  EXPECT_GT(e.ape.trans_m.max, 0.1);
+}
+
 TEST(Evaluate, JsonHasTheDocumentedKeysAndNoNonFiniteNumbers) {
   const Trajectory gt = serpentine();
   Trajectory est = gt;
