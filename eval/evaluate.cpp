@@ -265,7 +265,8 @@ nlohmann::json to_json(const Evaluation& e, const EvalOptions& options) {
   j["association"] = {{"pairs", e.association.size()},
                       {"gt_poses", e.gt_poses},
                       {"est_poses", e.est_poses},
-                      {"max_diff_s", options.association_tolerance_s}};
+                      {"max_diff_s", options.association_tolerance_s},
+                      {"reference_point_m", options.reference_point_m}};
   nlohmann::json R = nlohmann::json::array();
   for (int r = 0; r < 3; ++r)
     R.push_back({e.alignment.R(r, 0), e.alignment.R(r, 1), e.alignment.R(r, 2)});

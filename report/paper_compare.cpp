@@ -357,6 +357,21 @@ std::string findings(const nlohmann::json& m, const std::vector<std::string>& tw
   return out + "\n";
 }
 
+// Where the twin's truth was measured, when not at the camera (eval.reference_point_m): the
+// paper's truth was a prism the total station tracked, not its camera.
+std::string reference_point_note(const nlohmann::json& algorithm) {
+  const auto it = algorithm.find("association");
+  if (it == algorithm.end() || !it->contains("reference_point_m")) return "";
+  const std::vector<double> l = (*it)["reference_point_m"].get<std::vector<double>>();
+  if (l == std::vector<double>{0.0, 0.0, 0.0}) return "";
+  return fmt::format(
+      "The twin's truth is measured {:.2f} m from its camera, at [{}, {}, {}] m in the camera's "
+      "frame (x right, y down, z forward; `eval.reference_point_m`), as the paper's total station "
+      "tracked a prism on the vessel; the estimates are the camera's, with no lever-arm "
+      "correction.\n\n",
+      std::hypot(l[0], l[1], l[2]), l[0], l[1], l[2]);
+}
+
 }  // namespace
 
 std::optional<RiverPaperTrack> river_paper_track_of(const std::string& scenario_name) {
@@ -375,6 +390,7 @@ std::string river_paper_side_by_side(const nlohmann::json& metrics, RiverPaperTr
       num(at(sub(metrics, {"algorithms", twins.front()}), {"sections", "count"}), "{:.0f}"),
       num(at(sub(metrics, {"algorithms", twins.front()}), {"sections", "section_length_m"}),
           "{:.1f}"));
+  out += reference_point_note(sub(metrics, {"algorithms", twins.front()}));
   out += table1(metrics, twins);
   out += table2(metrics, twins, track);
   out += table3(metrics, twins);

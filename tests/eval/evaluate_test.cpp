@@ -128,6 +128,7 @@ TEST(Evaluate, JsonHasTheDocumentedKeysAndNoNonFiniteNumbers) {
   for (const char* key : {"rmse_3d_m", "rmse_2d_m", "max_3d_m", "max_2d_m", "rmse_3d_pct"})
     EXPECT_TRUE(j["track"][key].is_number()) << key;
   EXPECT_TRUE(j["subtracks"].contains("first_minute"));
+  EXPECT_EQ(j["association"]["reference_point_m"], nlohmann::json::array({0.0, 0.0, 0.0}));
   // Without per-frame covariates f and d are missing: the regression says so.
   EXPECT_NE(j["regression"]["skipped"].get<std::string>().find("f, d not available"),
             std::string::npos)

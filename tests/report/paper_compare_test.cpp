@@ -72,6 +72,25 @@ TEST(PaperCompare, PaperAndTwinColumnsSideBySideWithTheRightTrack) {
   EXPECT_EQ(discharge.find("13.36 (2.01)"), std::string::npos);
 }
 
+// A run whose truth is a point away from the camera (eval.reference_point_m) says so; one
+// measured at the camera, or from before the key existed, says nothing.
+TEST(PaperCompare, SaysWhereTheTruthWasMeasuredWhenNotAtTheCamera) {
+  nlohmann::json m;
+  m["scenario"] = "river_survey";
+  m["algorithms"]["sparse"] = algorithm(0.0456, 0.001);
+  const std::string old_run = river_paper_side_by_side(m, RiverPaperTrack::kTotal);
+  m["algorithms"]["sparse"]["association"]["reference_point_m"] = {0.0, 0.0, 0.0};
+  const std::string at_camera = river_paper_side_by_side(m, RiverPaperTrack::kTotal);
+  EXPECT_EQ(old_run, at_camera);
+  EXPECT_EQ(at_camera.find("truth is measured"), std::string::npos);
+  m["algorithms"]["sparse"]["association"]["reference_point_m"] = {-0.3, -0.4, 1.2};
+  const std::string prism = river_paper_side_by_side(m, RiverPaperTrack::kTotal);
+  EXPECT_NE(
+      prism.find("The twin's truth is measured 1.30 m from its camera, at [-0.3, -0.4, 1.2] m"),
+      std::string::npos)
+      << prism;
+}
+
 TEST(PaperCompare, TracksOfTheTwinScenariosAndARunWithoutTheAlgorithms) {
   EXPECT_EQ(river_paper_track_of("river_crossing"), RiverPaperTrack::kDischarge);
   EXPECT_EQ(river_paper_track_of("river_survey"), RiverPaperTrack::kTotal);
