@@ -82,6 +82,7 @@ int run_command(const std::string& file, const std::string& out_dir,
 
 struct EvalArgs {
   std::string gt, est, format = "tum", align = "horn", covariates, out, name, rpe_unit = "frames";
+  std::string vo;  // which of a run's VOs --covariates' columns to read (default: from the name)
   std::string regress = "v,h,f,d";
   std::string reference_point = "0,0,0";
   double section_length_m = 6.5;
@@ -118,6 +119,29 @@ int paper_command(const std::string& run, const std::string& track_name, const s
   return 0;
 }
 
+// --covariates: any per-frame CSV, or a run's frames.csv, of which the columns of the VO the
+// estimate came from are read as the run's own evaluation read them.
+driftlab::eval::FrameTable read_covariates(const EvalArgs& a, const std::string& algorithm) {
+  namespace eval = driftlab::eval;
+  eval::FrameTable table = eval::read_frame_table(a.covariates);
+  const std::vector<std::string> vos = eval::run_vo_names(table);
+  if (vos.empty()) {
+    if (!a.vo.empty())
+      throw driftlab::app::UsageError(fmt::format(
+          "--vo {}: {} is not a run's frames.csv (it has no NAME_valid columns, or it has plain "
+          "inliers / valid_depth_px / mean_depth_m columns)",
+          a.vo, a.covariates));
+    return table;
+  }
+  const std::string vo = a.vo.empty() ? eval::run_vo_of(vos, algorithm) : a.vo;
+  if (vo.empty())
+    throw driftlab::app::UsageError(fmt::format(
+        "{} is a run's frames.csv with the columns of {}; none of them is '{}' or a prefix of "
+        "it, expected --vo NAME to say whose columns to read",
+        a.covariates, fmt::join(vos, ", "), algorithm));
+  return eval::run_vo_covariates(table, vo, a.covariates);
+}
+
 int eval_command(const EvalArgs& a) {
   namespace eval = driftlab::eval;
   eval::EvaluationInput in;
@@ -145,7 +169,7 @@ int eval_command(const EvalArgs& a) {
   in.gt_label = a.gt;
   in.est_label = a.est;
   in.algorithm = a.name.empty() ? fs::path(a.est).stem().string() : a.name;
-  if (!a.covariates.empty()) in.frames = eval::read_frame_table(a.covariates);
+  if (!a.covariates.empty()) in.frames = read_covariates(a, in.algorithm);
   const eval::Evaluation e = eval::evaluate(in);
 
   driftlab::AtomicDirectory dir(a.out, a.force);
@@ -288,7 +312,11 @@ struct EvalVerb : Pinned {
     cmd->add_option("--rpe-unit", ev.rpe_unit, "RPE step unit: frames or meters")
         ->capture_default_str();
     cmd->add_option("--covariates", ev.covariates,
-                    "Per-frame covariates CSV (t_ns or t column; inliers, mean_depth_m, ...)");
+                    "Per-frame covariates CSV (t_ns or t column; inliers, mean_depth_m, ...), or "
+                    "a run's frames.csv");
+    cmd->add_option("--vo", ev.vo,
+                    "Whose columns of a run's frames.csv to read (default: the VO whose name the "
+                    "algorithm name is or starts with: sparse_kf_ca reads sparse_kf's)");
     cmd->add_option("--regress", ev.regress, "Comma-separated regression covariates")
         ->capture_default_str();
     cmd->add_option("--reference-point", ev.reference_point,

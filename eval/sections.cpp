@@ -46,6 +46,72 @@ const std::vector<double>* FrameTable::column(std::string_view name) const {
   return nullptr;
 }
 
+std::vector<std::string> run_vo_names(const FrameTable& table) {
+  std::vector<std::string> vos;
+  if (table.column("inliers") || table.column("valid_depth_px") || table.column("mean_depth_m"))
+    return vos;
+  constexpr std::string_view kValid = "_valid";
+  for (const std::string& name : table.names)
+    if (name.size() > kValid.size() &&
+        name.compare(name.size() - kValid.size(), kValid.size(), kValid) == 0)
+      vos.push_back(name.substr(0, name.size() - kValid.size()));
+  return vos;
+}
+
+std::string run_vo_of(const std::vector<std::string>& vos, const std::string& algorithm) {
+  std::string best;
+  for (const std::string& vo : vos) {
+    if (vo == algorithm) return vo;
+    if (algorithm.size() > vo.size() + 1 && algorithm.compare(0, vo.size(), vo) == 0 &&
+        algorithm[vo.size()] == '_' && vo.size() > best.size())
+      best = vo;
+  }
+  return best;
+}
+
+FrameTable run_vo_covariates(const FrameTable& run, const std::string& vo,
+                             const std::string& path) {
+  const std::vector<double>* valid = run.column(vo + "_valid");
+  if (!valid) {
+    std::string present;
+    for (const std::string& v : run_vo_names(run)) present += (present.empty() ? "" : ", ") + v;
+    throw UserError(
+        fmt::format("{}: no columns of a VO called '{}' (expected {}_valid, ...); the "
+                    "VOs in this table: {}",
+                    path, vo, vo, present.empty() ? "none" : present));
+  }
+  FrameTable out;
+  out.t_ns = run.t_ns;
+  auto put = [&](const std::string& name, std::vector<double> column) {
+    out.names.push_back(name);
+    out.columns.push_back(std::move(column));
+  };
+  for (const char* attitude : {"yaw_deg", "pitch_deg", "roll_deg"})
+    if (const auto* col = run.column(attitude)) put(attitude, *col);
+  const auto* features = run.column(vo + "_features");
+  const auto* inliers = run.column(vo + "_inliers");
+  const auto* depth_px = run.column(vo + "_valid_depth_px");
+  std::vector<double> f(run.t_ns.size(), kNaN);
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (!((*valid)[i] > 0)) continue;
+    if (features)
+      f[i] = (*features)[i];
+    else if (depth_px && (*depth_px)[i] > 0)
+      f[i] = (*depth_px)[i];
+    else if (inliers)
+      f[i] = (*inliers)[i];
+  }
+  if (features || inliers || depth_px) put("inliers", std::move(f));
+  if (const auto* d = run.column(vo + "_mean_depth_m")) {
+    std::vector<double> depth = *d;
+    for (std::size_t i = 0; i < depth.size(); ++i)
+      if (!((*valid)[i] > 0)) depth[i] = kNaN;
+    put("mean_depth_m", std::move(depth));
+  }
+  if (const auto* lost = run.column(vo + "_lost")) put("lost", *lost);
+  return out;
+}
+
 double Section::covariate(std::string_view name) const {
   for (std::size_t k = 0; k < covariate_names.size(); ++k)
     if (covariate_names[k] == name) return covariates[k];

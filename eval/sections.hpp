@@ -39,6 +39,27 @@ struct FrameTable {
 /// naming file, line and column on bad input.
 FrameTable read_frame_table(const std::string& path);
 
+/// The VOs whose per-frame columns a run's frames.csv holds (`driftlab run`, `driftlab vo`):
+/// NAME for each `NAME_valid` column, in order. Empty for a table that is not a run's, i.e.
+/// one with a plain `inliers`, `valid_depth_px` or `mean_depth_m` column.
+std::vector<std::string> run_vo_names(const FrameTable& table);
+
+/// Which of a run's VOs the estimate called `algorithm` came from: the VO of that name, else
+/// the longest VO name that `algorithm` starts with, followed by '_' (a filter on that VO:
+/// `sparse_kf_ca` is `sparse_kf`'s). Empty when none.
+std::string run_vo_of(const std::vector<std::string>& vos, const std::string& algorithm);
+
+/// From a run's frames.csv, the covariates the run's own evaluation of VO `vo` used: the
+/// platform's `yaw_deg`, `pitch_deg`, `roll_deg`; the VO's `NAME_features` as `inliers`
+/// (covariate f), `NAME_mean_depth_m` as `mean_depth_m` (d), both missing where the VO gave no
+/// motion (`NAME_valid` 0), and `NAME_lost` as `lost`. The run's other columns (render and
+/// camera timings, the other VOs) are left out, as in the run's evaluation. For a frames.csv
+/// written before `NAME_features` existed (2026-11-27), f is `NAME_valid_depth_px` where that
+/// is positive (the dense VO), else `NAME_inliers`. Throws UserError naming `path` and the VOs
+/// present when `vo` is not one of them.
+FrameTable run_vo_covariates(const FrameTable& run_frames, const std::string& vo,
+                             const std::string& path);
+
 struct SectionOptions {
   double section_length_m = 6.5;
 };

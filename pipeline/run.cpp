@@ -198,7 +198,7 @@ std::vector<Track> make_tracks(const Scenario& sc, const StereoRig& rig,
     t.name = sc.pipeline.vo[i];
     t.vo = std::move(vos[i]);
     t.results.resize(camera_gt.size());
-    for (auto& r : t.results) r.reason = "frame dropped";
+    for (auto& r : t.results) r.reason = kFrameDropped;
     tracks.push_back(std::move(t));
   }
   const SE3 T_W_B0 =
@@ -236,10 +236,12 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
     in.options = sc.eval;
     eval::FrameTable ft;
     // `lost`: 1 where the VO gave no motion, so each section's mean is its share of such
-    // frames (the sections a lost stretch touched).
+    // frames (the sections a lost stretch touched). The frames the camera delivered, as in
+    // frames.csv, so that `driftlab eval --covariates frames.csv` finds the same covariates.
     ft.names = {"yaw_deg", "pitch_deg", "roll_deg", "inliers", "mean_depth_m", "lost"};
     ft.columns.resize(6);
     for (std::size_t k = 0; k < camera_gt.size(); ++k) {
+      if (dropped_frame(src.results[k])) continue;
       ft.t_ns.push_back(camera_gt[k].t_ns);
       ft.columns[0].push_back(rad2deg(platform[k].yaw_rad));
       ft.columns[1].push_back(rad2deg(platform[k].pitch_rad));

@@ -7,13 +7,12 @@
 namespace driftlab::pipeline {
 namespace {
 constexpr const char* kFirstFrame = "first frame";
-constexpr const char* kDropped = "frame dropped";
 
 double seconds(TimeNs ns) { return static_cast<double>(ns) * 1e-9; }
 }  // namespace
 
 bool lost_track(const vo::VoResult& r) {
-  return !r.valid && r.reason != kFirstFrame && r.reason != kDropped;
+  return !r.valid && r.reason != kFirstFrame && !dropped_frame(r);
 }
 
 const LostStretch* TrackingSummary::longest() const {
@@ -32,7 +31,7 @@ TrackingSummary summarize_tracking(const std::vector<vo::VoResult>& results,
     if (k > 0)
       track_m += (camera_gt[k].T_W_C.translation() - camera_gt[k - 1].T_W_C.translation()).norm();
     const vo::VoResult& r = results[k];
-    if (r.reason == kDropped) {
+    if (dropped_frame(r)) {
       ++s.dropped;
       continue;
     }

@@ -38,6 +38,10 @@ struct TrackingSummary {
   const LostStretch* longest() const;
 };
 
+/// The reason of a frame the camera dropped (no image: the VO never saw it).
+inline constexpr const char* kFrameDropped = "frame dropped";
+inline bool dropped_frame(const vo::VoResult& r) { return r.reason == kFrameDropped; }
+
 /// Whether frame `r` counts as lost: invalid for a reason of the VO's, not the camera's
 /// (a dropped frame) nor the start (the first frame has nothing to match).
 bool lost_track(const vo::VoResult& r);

@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/yaml_io.hpp"
+#include "pipeline/tracking.hpp"
 #include "vo/dense/dense_vo.hpp"
 #include "vo/pnp/pnp_vo.hpp"
 #include "vo/registry.hpp"
@@ -60,13 +61,16 @@ void add_vo_timing(const vo::StereoOdometry& vo, const std::string& name, double
 
 std::string vo_csv_header(const std::string& name) {
   return fmt::format(
-      ",{0}_valid,{0}_inliers,{0}_valid_depth_px,{0}_mean_depth_m,{0}_ref_frames,{0}_ms", name);
+      ",{0}_valid,{0}_inliers,{0}_valid_depth_px,{0}_mean_depth_m,{0}_ref_frames,{0}_features,"
+      "{0}_lost,{0}_ms",
+      name);
 }
 
 std::string vo_csv_cells(const vo::VoResult& r) {
-  return fmt::format(",{},{},{},{},{},{:.3f}", r.valid ? 1 : 0, r.inliers, r.valid_depth_pixels,
-                     r.valid ? yaml::format_double(r.mean_inlier_depth_m) : "",
-                     r.reference_frames_back, r.times.total_ms);
+  return fmt::format(
+      ",{},{},{},{},{},{},{},{:.3f}", r.valid ? 1 : 0, r.inliers, r.valid_depth_pixels,
+      r.valid ? yaml::format_double(r.mean_inlier_depth_m) : "", r.reference_frames_back,
+      r.valid ? std::to_string(r.feature_count()) : "", lost_track(r) ? 1 : 0, r.times.total_ms);
 }
 
 }  // namespace driftlab::pipeline

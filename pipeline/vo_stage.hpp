@@ -33,7 +33,10 @@ void add_vo_timing(const vo::StereoOdometry& vo, const std::string& name, double
                    nlohmann::json* metrics);
 
 /// frames.csv columns of one VO: ",NAME_valid,NAME_inliers,NAME_valid_depth_px,
-/// NAME_mean_depth_m,NAME_ref_frames,NAME_ms".
+/// NAME_mean_depth_m,NAME_ref_frames,NAME_features,NAME_lost,NAME_ms". `_features` is the
+/// river paper's covariate f as the VO counts it (VoResult::feature_count(), empty where the VO
+/// gave no motion), `_lost` 1 where it lost track (lost_track()): with `_mean_depth_m` the
+/// columns that `driftlab eval --covariates` reads back (eval::run_vo_covariates()).
 std::string vo_csv_header(const std::string& name);
 /// The cells of one result under those columns (each with its leading comma).
 std::string vo_csv_cells(const vo::VoResult& result);

@@ -314,6 +314,55 @@ TEST(CliImageStats, CountsTheCornersOfACheckerboardAndNamesABadInput) {
   fs::remove_all(dir);
 }
 
+TEST(CliEval, ReadsARunsFramesCsvAsTheColumnsOfTheEstimatesVo) {
+  // A run's frames.csv with two VOs' blocks; the estimate file's name says whose f to read.
+  const fs::path dir = fresh_temp_dir("eval_frames");
+  write_tum_pair(dir);
+  fs::copy_file(dir / "est.tum", dir / "sparse_kf_ca.tum");
+  fs::copy_file(dir / "est.tum", dir / "other.tum");
+  {
+    std::ofstream f(dir / "frames.csv");
+    f << "t_ns,yaw_deg,render_ms,sparse_valid,sparse_features,sparse_kf_valid,sparse_kf_features,"
+         "sparse_kf_mean_depth_m\n";
+    for (int i = 0; i <= 60; ++i) f << i * 500'000'000LL << ",0,10,1,50,1," << 100 + i << ",20\n";
+  }
+  auto eval = [&](const std::string& est, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"eval",
+                                     "--gt",
+                                     (dir / "gt.tum").string(),
+                                     "--est",
+                                     (dir / est).string(),
+                                     "--covariates",
+                                     (dir / "frames.csv").string(),
+                                     "--align",
+                                     "none",
+                                     "--out",
+                                     (dir / ("out_" + est)).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_cli(args);
+  };
+  // sparse_kf's f: 100 + i; the 4 sections span rows 0-13, 13-26, 26-39 and 39-52, with means
+  // 106.5, 119.5, 132.5 and 145.5: 126 on average.
+  Result r = eval("sparse_kf_ca.tum", {});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  auto j = nlohmann::json::parse(read_text(dir / "out_sparse_kf_ca.tum/metrics.json"));
+  EXPECT_NEAR(j["covariates"]["f"]["mean"].get<double>(), 126.0, 1e-12);
+  EXPECT_NEAR(j["covariates"]["d"]["mean"].get<double>(), 20.0, 1e-12);
+  EXPECT_FALSE(j["covariates"].contains("render_ms"));  // the run's other columns are left out
+  // No VO of that name: say so, and how to choose; --vo chooses.
+  r = eval("other.tum", {});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.err.find("with the columns of sparse, sparse_kf; none of them is 'other'"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out_other.tum"));
+  r = eval("other.tum", {"--vo", "sparse"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  j = nlohmann::json::parse(read_text(dir / "out_other.tum/metrics.json"));
+  EXPECT_NEAR(j["covariates"]["f"]["mean"].get<double>(), 50.0, 1e-12);
+  fs::remove_all(dir);
+}
+
 TEST(CliEval, BadInputFailsAndLeavesNothing) {
   const fs::path dir = fresh_temp_dir("eval_bad");
   write_tum_pair(dir);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "core/error.hpp"
 
@@ -12,6 +13,7 @@ namespace driftlab::eval {
 namespace {
 
 constexpr double kTol = 1e-12;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A camera looking north (optical z = world x) and level: optical x -> east,
 // optical y -> down. This is the world orientation of the camera FRD axes = identity.
@@ -112,6 +114,57 @@ TEST(Sections, CovariatesFromTheFrameTable) {
   const Summary f = summarize_covariate(sections, "f");
   EXPECT_EQ(f.n, 2u);
   EXPECT_NEAR(f.mean, (103.5 + 110.5) / 2.0, kTol);
+}
+
+TEST(Sections, ARunsFrameTableGivesEachVoItsCovariates) {
+  // A run's frames.csv: the platform's attitude, a timing column and per VO its block.
+  FrameTable run;
+  run.names = {"yaw_deg",        "render_ms",           "sparse_valid",
+               "sparse_inliers", "sparse_mean_depth_m", "sparse_features",
+               "sparse_lost",    "sparse_kf_valid",     "sparse_kf_inliers"};
+  run.t_ns = {0, 1, 2};
+  run.columns = {{1, 2, 3},         {9, 9, 9}, {0, 1, 0}, {0, 120, 0}, {kNaN, 21.5, kNaN},
+                 {kNaN, 118, kNaN}, {0, 0, 1}, {0, 1, 1}, {0, 80, 90}};
+  const std::vector<std::string> vos = run_vo_names(run);
+  EXPECT_EQ(vos, (std::vector<std::string>{"sparse", "sparse_kf"}));
+  EXPECT_EQ(run_vo_of(vos, "sparse"), "sparse");
+  EXPECT_EQ(run_vo_of(vos, "sparse_kf"), "sparse_kf");
+  EXPECT_EQ(run_vo_of(vos, "sparse_kf_ca"), "sparse_kf");  // the longest prefix
+  EXPECT_EQ(run_vo_of(vos, "sparse_ca"), "sparse");
+  EXPECT_EQ(run_vo_of(vos, "sparsely"), "");  // a prefix must end at a '_'
+  EXPECT_EQ(run_vo_of(vos, "dense"), "");
+
+  const FrameTable s = run_vo_covariates(run, "sparse", "frames.csv");
+  EXPECT_EQ(s.names, (std::vector<std::string>{"yaw_deg", "inliers", "mean_depth_m", "lost"}));
+  EXPECT_EQ(s.t_ns, run.t_ns);
+  // f is the VO's own feature count, not its inliers, and missing where it gave no motion.
+  EXPECT_TRUE(std::isnan((*s.column("inliers"))[0]));
+  EXPECT_EQ((*s.column("inliers"))[1], 118.0);
+  EXPECT_EQ((*s.column("mean_depth_m"))[1], 21.5);
+  EXPECT_EQ(*s.column("lost"), (std::vector<double>{0, 0, 1}));
+
+  // Before the `_features` column (2026-11-27): the inliers, or the dense VO's valid-depth
+  // pixels; no `lost`.
+  const FrameTable kf = run_vo_covariates(run, "sparse_kf", "frames.csv");
+  EXPECT_EQ(kf.names, (std::vector<std::string>{"yaw_deg", "inliers"}));
+  EXPECT_TRUE(std::isnan((*kf.column("inliers"))[0]));
+  EXPECT_EQ((*kf.column("inliers"))[2], 90.0);
+  run.names[8] = "sparse_kf_valid_depth_px";
+  EXPECT_EQ((*run_vo_covariates(run, "sparse_kf", "f.csv").column("inliers"))[2], 90.0);
+
+  try {
+    run_vo_covariates(run, "dense", "out/frames.csv");
+    ADD_FAILURE() << "no throw";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("out/frames.csv: no columns of a VO called 'dense'"),
+              std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("sparse, sparse_kf"), std::string::npos);
+  }
+  // A covariate table of one's own is not a run's.
+  FrameTable own;
+  own.names = {"inliers", "x_valid"};
+  own.columns.resize(2);
+  EXPECT_TRUE(run_vo_names(own).empty());
 }
 
 TEST(Sections, ReadsFrameTableAndRejectsBadFiles) {

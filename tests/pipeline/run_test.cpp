@@ -11,8 +11,11 @@
 #include <sstream>
 
 #include "core/csv.hpp"
+#include "core/error.hpp"
 #include "core/rotation.hpp"
 #include "core/trajectory_io.hpp"
+#include "eval/evaluate.hpp"
+#include "eval/sections.hpp"
 #include "tests/support/test_support.hpp"
 
 #include <nlohmann/json.hpp>
@@ -145,6 +148,49 @@ TEST(Run, SameBytesWhateverTheThreadCount) {
   EXPECT_NE(frames_without_timing(a).find("sparse_kf_ref_frames"), std::string::npos);
   fs::remove_all(a);
   fs::remove_all(b);
+}
+
+// The rows of a sections.csv whose algorithm column is `algo`.
+std::vector<std::string> section_rows(const std::string& csv, const std::string& algo) {
+  std::istringstream in(csv);
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(in, line))
+    if (line.rfind(algo + ",", 0) == 0) rows.push_back(line);
+  return rows;
+}
+
+TEST(Run, ItsFramesCsvGivesDriftlabEvalTheRunsOwnCovariates) {
+  // `driftlab eval --covariates DIR/frames.csv` reads the columns of the VO an estimate came
+  // from as the run's own evaluation used them (f as the VO counts its features: inliers for the
+  // sparse VO, valid-depth pixels for the dense; d; the share of lost frames; the platform's
+  // attitude for h): the same sections.csv rows, covariate by covariate, for each VO and for the
+  // smoother on one, with dropped frames.
+  const fs::path out = temp_dir("eval_back");
+  Scenario sc = short_crossing(40);
+  sc.pipeline.vo = {"sparse", "dense"};
+  sc.sensors.camera.clock.drop_probability = 0.1;
+  sc.eval.section_length_m = 0.25;
+  run_scenario(sc, out, {});
+  const std::string run_sections = slurp(out / "sections.csv");
+  const eval::FrameTable frames = eval::read_frame_table((out / "frames.csv").string());
+  const std::vector<std::string> vos = eval::run_vo_names(frames);
+  ASSERT_EQ(vos, (std::vector<std::string>{"sparse", "dense"}));
+  for (const std::string algo : {"sparse", "dense", "sparse_ca"}) {
+    eval::EvaluationInput in;
+    in.gt = read_tum(out / "groundtruth.tum");
+    in.est = read_tum(out / ("estimates/" + algo + ".tum"));
+    in.algorithm = algo;
+    in.options = sc.eval;
+    in.frames = eval::run_vo_covariates(frames, eval::run_vo_of(vos, algo), "frames.csv");
+    const std::string csv = eval::sections_csv(eval::evaluate(in));
+    EXPECT_EQ(csv.substr(0, csv.find('\n')), run_sections.substr(0, run_sections.find('\n')));
+    const std::vector<std::string> rows = section_rows(csv, algo);
+    EXPECT_GE(rows.size(), 3u) << algo;
+    EXPECT_EQ(rows, section_rows(run_sections, algo)) << algo;
+  }
+  EXPECT_THROW(eval::run_vo_covariates(frames, "sparse_kf", "frames.csv"), UserError);
+  fs::remove_all(out);
 }
 
 TEST(Run, SensorsSampleAtTheirRatesFromTheSameGroundTruth) {
