@@ -16,6 +16,7 @@
 #include "pipeline/frame_source.hpp"
 #include "pipeline/progress.hpp"
 #include "pipeline/sensor_stage.hpp"
+#include "pipeline/tracking.hpp"
 #include "pipeline/tracks.hpp"
 #include "pipeline/vo_stage.hpp"
 #include "sim/sensors/clock.hpp"
@@ -39,17 +40,18 @@ std::pair<std::size_t, SE3> first_anchored(const dataset::StereoDataset& d) {
 }
 
 // Per-frame covariates of a track (its VO's): the features it counts (covariate f of the river
-// paper's Table 4) and their mean depth.
+// paper's Table 4), their mean depth and whether it lost track, as frames.csv has them.
 eval::FrameTable covariates(const Track& src, const std::vector<dataset::DatasetFrame>& frames) {
   eval::FrameTable ft;
-  ft.names = {"inliers", "mean_depth_m"};
-  ft.columns.resize(2);
+  ft.names = {"inliers", "mean_depth_m", "lost"};
+  ft.columns.resize(3);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t k = 0; k < src.results.size(); ++k) {
     const vo::VoResult& r = src.results[k];
     ft.t_ns.push_back(frames[k].t_ns);
     ft.columns[0].push_back(r.valid ? r.feature_count() : nan);
     ft.columns[1].push_back(r.valid ? r.mean_inlier_depth_m : nan);
+    ft.columns[2].push_back(lost_track(r) ? 1.0 : 0.0);
   }
   return ft;
 }

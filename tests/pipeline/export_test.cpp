@@ -14,6 +14,8 @@
 
 #include "core/csv.hpp"
 #include "core/trajectory_io.hpp"
+#include "eval/evaluate.hpp"
+#include "eval/sections.hpp"
 #include "pipeline/dataset_run.hpp"
 #include "pipeline/run.hpp"
 #include "pipeline/vo_stage.hpp"
@@ -30,6 +32,7 @@ Scenario short_crossing_with_drops() {
   s.pipeline.max_frames = 30;
   s.pipeline.vo = {"sparse", "sparse_kf"};
   s.sensors.camera.clock.drop_probability = 0.1;
+  s.eval.section_length_m = 0.25;  // sections in the 30 frames' metre or two
   return s;
 }
 
@@ -113,6 +116,29 @@ TEST_P(ExportRoundTrip, BuiltInVoOnTheExportGivesTheRunsEstimate) {
     ++compared;
   }
   EXPECT_GE(compared, run_sparse.size() - 1);
+  // `driftlab eval --covariates` on the VO run's frames.csv finds the covariates its own
+  // evaluation used: the same sections.csv rows.
+  const eval::FrameTable vo_frames = eval::read_frame_table((vo / "frames.csv").string());
+  const std::string vo_sections = slurp(vo / "sections.csv");
+  for (const std::string name : {"sparse", "sparse_kf_ca"}) {
+    eval::EvaluationInput in;
+    in.gt = data.camera_gt;
+    in.est = read_tum(vo / "estimates" / (name + ".tum"));
+    in.algorithm = name;
+    in.options = settings.eval;
+    in.frames = eval::run_vo_covariates(
+        vo_frames, eval::run_vo_of(eval::run_vo_names(vo_frames), name), "frames.csv");
+    const std::string csv = eval::sections_csv(eval::evaluate(in));
+    EXPECT_EQ(csv.substr(0, csv.find('\n')), vo_sections.substr(0, vo_sections.find('\n')));
+    std::istringstream mine(csv), theirs(vo_sections);
+    std::vector<std::string> a, b;
+    for (std::string line; std::getline(mine, line);)
+      if (line.rfind(name + ",", 0) == 0) a.push_back(line);
+    for (std::string line; std::getline(theirs, line);)
+      if (line.rfind(name + ",", 0) == 0) b.push_back(line);
+    EXPECT_FALSE(a.empty()) << name;
+    EXPECT_EQ(a, b) << name;
+  }
   const auto metrics = nlohmann::json::parse(slurp(vo / "metrics.json"));
   EXPECT_TRUE(metrics["algorithms"].contains("sparse"));
   EXPECT_EQ(metrics["dataset"]["frames_used"].get<std::size_t>(), run_sparse.size());
