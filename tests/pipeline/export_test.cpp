@@ -130,14 +130,15 @@ TEST_P(ExportRoundTrip, BuiltInVoOnTheExportGivesTheRunsEstimate) {
         vo_frames, eval::run_vo_of(eval::run_vo_names(vo_frames), name), "frames.csv");
     const std::string csv = eval::sections_csv(eval::evaluate(in));
     EXPECT_EQ(csv.substr(0, csv.find('\n')), vo_sections.substr(0, vo_sections.find('\n')));
-    std::istringstream mine(csv), theirs(vo_sections);
-    std::vector<std::string> a, b;
-    for (std::string line; std::getline(mine, line);)
-      if (line.rfind(name + ",", 0) == 0) a.push_back(line);
-    for (std::string line; std::getline(theirs, line);)
-      if (line.rfind(name + ",", 0) == 0) b.push_back(line);
-    EXPECT_FALSE(a.empty()) << name;
-    EXPECT_EQ(a, b) << name;
+    auto rows_of = [&](const std::string& text) {
+      std::istringstream in(text);
+      std::vector<std::string> rows;
+      for (std::string line; std::getline(in, line);)
+        if (line.rfind(name + ",", 0) == 0) rows.push_back(line);
+      return rows;
+    };
+    EXPECT_FALSE(rows_of(csv).empty()) << name;
+    EXPECT_EQ(rows_of(csv), rows_of(vo_sections)) << name;
   }
   const auto metrics = nlohmann::json::parse(slurp(vo / "metrics.json"));
   EXPECT_TRUE(metrics["algorithms"].contains("sparse"));
