@@ -14,6 +14,9 @@
 #include <tuple>
 
 #include "core/error.hpp"
+#include "sim/render/gl_program.hpp"
+#include "sim/render/mip_chain.hpp"
+#include "sim/render/mip_chain_gl.hpp"
 #include "sim/render/shaders.hpp"
 
 namespace driftlab::sim {
@@ -21,40 +24,6 @@ namespace {
 
 constexpr float kNear = 0.05f;
 constexpr float kFar = 5000.f;
-
-GLuint compile(GLenum type, const char* source, const char* what) {
-  const GLuint s = glCreateShader(type);
-  glShaderSource(s, 1, &source, nullptr);
-  glCompileShader(s);
-  GLint ok = 0;
-  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[4096];
-    glGetShaderInfoLog(s, sizeof log, nullptr, log);
-    throw InternalError(fmt::format("renderer: {} shader failed to compile: {}", what, log));
-  }
-  return s;
-}
-
-GLuint program(const char* vs, const char* fs, const char* what, const std::string& defines = "") {
-  const GLuint p = glCreateProgram();
-  const std::string head = "#version 450 core\n" + defines;
-  const GLuint v = compile(GL_VERTEX_SHADER, (head + vs).c_str(), what);
-  const GLuint f = compile(GL_FRAGMENT_SHADER, (head + fs).c_str(), what);
-  glAttachShader(p, v);
-  glAttachShader(p, f);
-  glLinkProgram(p);
-  glDeleteShader(v);
-  glDeleteShader(f);
-  GLint ok = 0;
-  glGetProgramiv(p, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[4096];
-    glGetProgramInfoLog(p, sizeof log, nullptr, log);
-    throw InternalError(fmt::format("renderer: {} program failed to link: {}", what, log));
-  }
-  return p;
-}
 
 GLint loc(GLuint p, const char* name) { return glGetUniformLocation(p, name); }
 
@@ -111,6 +80,7 @@ struct StereoRenderer::Impl {
   SE3 T_left_right;  // the true right camera (defaults to the rig's baseline)
   RenderOptions options;
   std::unique_ptr<GlContext> context;
+  std::unique_ptr<MipChain> mip_chain;  // the mirror image's blur levels under wind ripples
   // Programs by variant: [mode][sun] with mode 0 gray, 1 linear depth.
   GLuint scene_progs[2][2] = {};
   GLuint water_progs[2][2][2] = {};  // [mode][sun][ripples]
@@ -182,16 +152,17 @@ StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& option
     for (int sun : {0, 1}) {
       const std::string defines = fmt::format("#define DEPTH {}\n#define SUN {}\n", mode, sun);
       impl_->scene_progs[mode][sun] =
-          program(shaders::kSceneVs, shaders::kSceneFs, "scene", defines);
+          link_program(shaders::kSceneVs, shaders::kSceneFs, "scene", defines);
       for (int ripples : {0, 1})
         impl_->water_progs[mode][sun][ripples] =
-            program(shaders::kWaterVs, shaders::kWaterFs, "water",
-                    defines + fmt::format("#define RIPPLES {}\n", ripples));
+            link_program(shaders::kWaterVs, shaders::kWaterFs, "water",
+                         defines + fmt::format("#define RIPPLES {}\n", ripples));
     }
   for (int sun : {0, 1})
     impl_->sky_progs[sun] =
-        program(shaders::kSkyVs, shaders::kSkyFs, "sky", fmt::format("#define SUN {}\n", sun));
+        link_program(shaders::kSkyVs, shaders::kSkyFs, "sky", fmt::format("#define SUN {}\n", sun));
   glGenVertexArrays(1, &impl_->empty_vao);
+  impl_->mip_chain = std::make_unique<MipChain>();
   impl_->proj = projection_from_intrinsics(rig.camera, kNear, kFar);
   impl_->build_water_grid();
   impl_->build_framebuffers();
@@ -299,7 +270,7 @@ void StereoRenderer::Impl::build_eye_targets(EyeTargets* e) {
   // which its own MSAA (render.reflection_msaa_samples) only halves. Its mip
   // levels (made only when wind ripples blur it) are the rough-mirror blur.
   const int RW = refl_width, RH = refl_height;
-  refl_levels = 1 + static_cast<int>(std::floor(std::log2(std::max(RW, RH))));
+  refl_levels = mip_level_count(RW, RH);
   color_target_(&e->refl_fbo, &e->refl_tex, GL_R8, &e->refl_depth, RW, RH, refl_levels);
   if (options.reflection_msaa_samples > 1)
     multisample_target_(&e->refl_msaa_fbo, &e->refl_msaa_color, &e->refl_msaa_depth,
@@ -669,10 +640,7 @@ void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, int eye_index) {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.refl_fbo);
     glBlitFramebuffer(0, 0, RW, RH, 0, 0, RW, RH, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
-  if (!ripples.empty()) {
-    glBindTexture(GL_TEXTURE_2D, e.refl_tex);
-    glGenerateMipmap(GL_TEXTURE_2D);
-  }
+  if (!ripples.empty()) mip_chain->build(e.refl_tex, RW, RH, refl_levels);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 

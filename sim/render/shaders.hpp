@@ -317,4 +317,26 @@ void main() {
 }
 )";
 
+// One mip level of the mirror image from the level above (sim/render/mip_chain.hpp): a
+// triangle over the level, each texel the mean of the 2x2 texels above it.
+inline constexpr const char* kMipVs = R"(
+void main() {
+  vec2 p = vec2((gl_VertexID == 1) ? 3.0 : -1.0, (gl_VertexID == 2) ? 3.0 : -1.0);
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+
+inline constexpr const char* kMipFs = R"(
+uniform sampler2D u_src;   // its base and max level: the level above
+out vec4 frag;
+void main() {
+  ivec2 last = textureSize(u_src, 0) - 1;
+  ivec2 p = 2 * ivec2(gl_FragCoord.xy);
+  float s = texelFetch(u_src, min(p, last), 0).r + texelFetch(u_src, min(p + ivec2(1, 0), last), 0).r
+          + texelFetch(u_src, min(p + ivec2(0, 1), last), 0).r
+          + texelFetch(u_src, min(p + ivec2(1, 1), last), 0).r;
+  frag = vec4(0.25 * s, 0.0, 0.0, 1.0);
+}
+)";
+
 }  // namespace driftlab::sim::shaders

@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "core/rotation.hpp"
+#include "sim/render/mip_chain.hpp"
 #include "sim/waves/wave_field.hpp"
 
 namespace driftlab::sim {
@@ -428,6 +429,40 @@ TEST(Render, OneSidedMeshesSkipOnlyTheirBackFaces) {
   EXPECT_GT(differing_pixels(away2.left, empty.left), 20000);
   EXPECT_EQ(differing_pixels(away1.left, empty.left), 0);
   EXPECT_EQ(differing_pixels(away1.right, empty.right), 0);
+}
+
+TEST(Render, MipLevelsOfTheMirrorImageAreTwoByTwoMeans) {
+  // The blur levels of the rippled mirror image, drawn on llvmpipe's raster threads: each texel
+  // the mean of the 2x2 texels above it, an odd last row or column left out, rounded to the
+  // nearest 8-bit level (either neighbour at an exact half). Odd and even sizes, down to 1x1.
+  for (const auto& [W, H] : {std::pair{64, 48}, std::pair{37, 20}}) {
+    GrayImage base;
+    base.width = W;
+    base.height = H;
+    Rng rng = RngStreams(5).stream("mip");
+    for (int i = 0; i < W * H; ++i)
+      base.pixels.push_back(static_cast<std::uint8_t>(rng.uniform_int(256)));
+    const std::vector<GrayImage> levels = draw_mip_levels(base, RenderBackend::kOsmesa);
+    ASSERT_EQ(static_cast<int>(levels.size()) + 1, mip_level_count(W, H));
+    EXPECT_EQ(levels.back().width * levels.back().height, 1);
+    const GrayImage* above = &base;
+    for (const GrayImage& level : levels) {
+      ASSERT_EQ(level.width, std::max(1, above->width / 2));
+      ASSERT_EQ(level.height, std::max(1, above->height / 2));
+      double worst = 0;
+      for (int y = 0; y < level.height; ++y)
+        for (int x = 0; x < level.width; ++x) {
+          double sum = 0;
+          for (int dy : {0, 1})
+            for (int dx : {0, 1})
+              sum += above->at(std::min(2 * x + dx, above->width - 1),
+                               std::min(2 * y + dy, above->height - 1));
+          worst = std::max(worst, std::abs(level.at(x, y) - sum / 4));
+        }
+      EXPECT_LE(worst, 0.5) << W << "x" << H << " level " << level.width << "x" << level.height;
+      above = &level;
+    }
+  }
 }
 
 TEST(Render, BadRigIsAClearError) {
