@@ -7,17 +7,23 @@
 namespace driftlab::sim {
 namespace {
 
+// Throws with the object's info log unless its `status` (compile or link) is set.
+void check(GLuint object, GLenum status, decltype(glGetShaderiv) get_iv,
+           decltype(glGetShaderInfoLog) get_log, const std::string& what) {
+  GLint ok = 0;
+  get_iv(object, status, &ok);
+  if (ok) return;
+  char log[4096];
+  get_log(object, sizeof log, nullptr, log);
+  throw InternalError(fmt::format("renderer: {} failed: {}", what, log));
+}
+
 GLuint compile(GLenum type, const char* source, const char* what) {
   const GLuint s = glCreateShader(type);
   glShaderSource(s, 1, &source, nullptr);
   glCompileShader(s);
-  GLint ok = 0;
-  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[4096];
-    glGetShaderInfoLog(s, sizeof log, nullptr, log);
-    throw InternalError(fmt::format("renderer: {} shader failed to compile: {}", what, log));
-  }
+  check(s, GL_COMPILE_STATUS, glGetShaderiv, glGetShaderInfoLog,
+        fmt::format("{} shader compilation", what));
   return s;
 }
 
@@ -33,13 +39,8 @@ GLuint link_program(const char* vs, const char* fs, const char* what, const std:
   glLinkProgram(p);
   glDeleteShader(v);
   glDeleteShader(f);
-  GLint ok = 0;
-  glGetProgramiv(p, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[4096];
-    glGetProgramInfoLog(p, sizeof log, nullptr, log);
-    throw InternalError(fmt::format("renderer: {} program failed to link: {}", what, log));
-  }
+  check(p, GL_LINK_STATUS, glGetProgramiv, glGetProgramInfoLog,
+        fmt::format("{} program linking", what));
   return p;
 }
 
