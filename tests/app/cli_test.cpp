@@ -167,8 +167,10 @@ TEST(Cli, KilledRunLeavesNoOutputFolder) {
                           shell_quote((kSource / "scenarios/river_crossing.yaml").string()) +
                           " --out " + shell_quote(out.string()) + " > " +
                           shell_quote(log.string()) + " 2>&1 & pid=$!; " +
-                          // wait until the frame loop reports progress, then kill
-                          "for i in $(seq 1 600); do grep -q frames " + shell_quote(log.string()) +
+                          // wait until the frame loop reports progress, then kill; up to
+                          // 300 s, since under AddressSanitizer the physics stage before the
+                          // loop alone takes 50 s of an idle CI machine (60 s was too short)
+                          "for i in $(seq 1 3000); do grep -q frames " + shell_quote(log.string()) +
                           " && break; sleep 0.1; done; kill -9 $pid; wait $pid";
   const int status = std::system(("bash -c " + shell_quote(cmd)).c_str());
   ASSERT_TRUE(WIFEXITED(status));
