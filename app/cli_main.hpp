@@ -8,6 +8,9 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+
+#include "core/error.hpp"
 
 namespace driftlab::app {
 
@@ -29,6 +32,19 @@ struct Unavailable : std::runtime_error {
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+/// Runs `f`, turning a UserError into a UsageError ("FLAG: " and its message): for the values
+/// of command-line options that library code checks (a format's name, an eval option), which
+/// are a bad command line, not bad input.
+template <class F>
+auto as_usage_error(std::string_view flag, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const UserError& e) {
+    throw UsageError(flag.empty() ? std::string(e.what())
+                                  : std::string(flag) + ": " + std::string(e.what()));
+  }
+}
 
 /// Parses argv into `app` and runs `dispatch`, mapping a bad command line to kExitUsage (after
 /// CLI11 printed why; --help and --version exit 0), UsageError to kExitUsage, UserError to

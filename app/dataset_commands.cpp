@@ -5,6 +5,7 @@
 
 #include <iostream>
 
+#include "app/cli_main.hpp"
 #include "core/error.hpp"
 #include "pipeline/dataset_run.hpp"
 #include "pipeline/export_stage.hpp"
@@ -59,7 +60,7 @@ int DatasetCommands::export_dataset() {
   if (frames_ > 0) sets.push_back(fmt::format("pipeline.max_frames={}", frames_));
   const auto scenario = pipeline::load_scenario(scenario_, sets);
   pipeline::ExportOptions o;
-  o.format = dataset::format_from_name(format_);
+  o.format = as_usage_error("--format", [&] { return dataset::format_from_name(format_); });
   o.sequence = sequence_;
   o.replace_existing = force_;
   o.progress = stderr;
@@ -87,7 +88,8 @@ int DatasetCommands::run_vo() {
   const auto settings = settings_.empty() ? pipeline::parse_scenario("name: driftlab-vo\n",
                                                                      "built-in defaults", ".", sets)
                                           : pipeline::load_scenario(settings_, sets);
-  const auto format = dataset::format_from_name(format_);
+  const auto format =
+      as_usage_error("--format", [&] { return dataset::format_from_name(format_); });
   dataset::ReadOptions read;
   read.sequence = sequence_;
   const dataset::StereoDataset data = dataset::read_dataset(dataset_, format, read);

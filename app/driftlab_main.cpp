@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <unistd.h>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 
@@ -145,25 +146,27 @@ driftlab::eval::FrameTable read_covariates(const EvalArgs& a, const std::string&
 int eval_command(const EvalArgs& a) {
   namespace eval = driftlab::eval;
   eval::EvaluationInput in;
-  // The flags map onto the scenario's `eval` section so the same checks apply.
-  const std::vector<std::string> sets = {
-      "section_length_m=" + fmt::format("{}", a.section_length_m),
-      "length_sample_m=" + fmt::format("{}", a.length_sample_m),
-      "align=" + a.align,
-      "align_first_n=" + std::to_string(a.align_first_n),
-      "association_tolerance_s=" + fmt::format("{}", a.max_diff_s),
-      "rpe_delta=" + fmt::format("{}", a.rpe_delta),
-      "rpe_unit=" + a.rpe_unit,
-      "regression_covariates=[" + a.regress + "]",
-      "reference_point_m=[" + a.reference_point + "]"};
-  for (const auto& set : sets) {
-    const auto eq = set.find('=');
-    driftlab::yaml::read_into(driftlab::yaml::override_document(set),
-                              {"--" + set.substr(0, eq) + " " + set.substr(eq + 1), false},
-                              &in.options);
-  }
-  driftlab::yaml::validate_or_throw(in.options, "driftlab eval");
-  const auto format = driftlab::format_from_name(a.format);
+  // The flags map onto the scenario's `eval` section so the same checks apply; a bad value is
+  // a bad command line, its message starting with the flag as given.
+  const std::vector<std::array<std::string, 3>> flags = {
+      {"--section-length", "section_length_m", fmt::format("{}", a.section_length_m)},
+      {"--length-sample", "length_sample_m", fmt::format("{}", a.length_sample_m)},
+      {"--align", "align", a.align},
+      {"--align-first-n", "align_first_n", std::to_string(a.align_first_n)},
+      {"--max-diff", "association_tolerance_s", fmt::format("{}", a.max_diff_s)},
+      {"--rpe-delta", "rpe_delta", fmt::format("{}", a.rpe_delta)},
+      {"--rpe-unit", "rpe_unit", a.rpe_unit},
+      {"--regress", "regression_covariates", "[" + a.regress + "]"},
+      {"--reference-point", "reference_point_m", "[" + a.reference_point + "]"}};
+  for (const auto& [flag, key, value] : flags)
+    driftlab::app::as_usage_error("", [&] {
+      driftlab::yaml::read_into(driftlab::yaml::override_document(key + "=" + value),
+                                {flag + " " + value, false}, &in.options);
+    });
+  driftlab::app::as_usage_error(
+      "", [&] { driftlab::yaml::validate_or_throw(in.options, "driftlab eval"); });
+  const auto format = driftlab::app::as_usage_error(
+      "--format", [&] { return driftlab::format_from_name(a.format); });
   in.gt = driftlab::read_trajectory(a.gt, format);
   in.est = driftlab::read_trajectory(a.est, format);
   in.gt_label = a.gt;

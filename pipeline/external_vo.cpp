@@ -2,8 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
+#include <cctype>
 #include <cmath>
+#include <csignal>
 #include <numbers>
+#include <optional>
+#include <string_view>
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -67,29 +73,59 @@ std::optional<double> heading_disagreement_deg(const Trajectory& est, const Traj
 
 }  // namespace
 
+namespace {
+
+constexpr std::array<std::string_view, 4> kPlaceholders{"dir", "root", "out", "driftlab"};
+
+// "{name}" at [begin, end) of a command.
+struct Placeholder {
+  std::size_t begin = 0, end = 0;
+  std::string name;
+};
+
+bool is_name_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// The next word in braces ("{name}", name of letters, digits and '_') at or after `from`, other
+// than the shell's "${name}".
+std::optional<Placeholder> next_placeholder(const std::string& command, std::size_t from) {
+  for (std::size_t i = command.find('{', from); i != std::string::npos;
+       i = command.find('{', i + 1)) {
+    if (i > 0 && command[i - 1] == '$') continue;
+    std::size_t j = i + 1;
+    while (j < command.size() && is_name_char(command[j])) ++j;
+    if (j > i + 1 && j < command.size() && command[j] == '}')
+      return Placeholder{i, j + 1, command.substr(i + 1, j - i - 1)};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::string unknown_command_placeholder(const std::string& command) {
+  for (auto p = next_placeholder(command, 0); p; p = next_placeholder(command, p->end))
+    if (std::find(kPlaceholders.begin(), kPlaceholders.end(), p->name) == kPlaceholders.end())
+      return "{" + p->name + "}";
+  return "";
+}
+
 std::string expand_command(const std::string& command, const fs::path& dir, const fs::path& root,
                            const fs::path& out, const fs::path& driftlab) {
+  const std::array<const fs::path*, kPlaceholders.size()> values{&dir, &root, &out, &driftlab};
   std::string result;
-  for (std::size_t i = 0; i < command.size();) {
-    if (command[i] != '{') {
-      result += command[i++];
-      continue;
-    }
-    const std::size_t close = command.find('}', i);
-    const std::string key = close == std::string::npos ? "" : command.substr(i + 1, close - i - 1);
-    const fs::path* value = key == "dir"        ? &dir
-                            : key == "root"     ? &root
-                            : key == "out"      ? &out
-                            : key == "driftlab" ? &driftlab
-                                                : nullptr;
-    if (!value)
-      throw UserError(fmt::format(
-          "pipeline.external_vo: command: got '{}', expected placeholders {{dir}}, {{root}}, "
-          "{{out}} or {{driftlab}} only",
-          command.substr(i, close == std::string::npos ? std::string::npos : close - i + 1)));
-    result += shell_quote(value->string());
-    i = close + 1;
+  std::size_t at = 0;
+  for (auto p = next_placeholder(command, 0); p; p = next_placeholder(command, p->end)) {
+    const auto known = std::find(kPlaceholders.begin(), kPlaceholders.end(), p->name);
+    if (known == kPlaceholders.end())
+      throw UserError(
+          fmt::format("pipeline.external_vo: command: got '{{{}}}', expected placeholders "
+                      "{{dir}}, {{root}}, {{out}} or {{driftlab}} only",
+                      p->name));
+    result.append(command, at, p->begin - at);
+    result +=
+        shell_quote(values[static_cast<std::size_t>(known - kPlaceholders.begin())]->string());
+    at = p->end;
   }
+  result.append(command, at);
   return result;
 }
 
@@ -193,7 +229,11 @@ std::vector<ExternalVoResult> ExternalVoStage::finish(
                 {"exit", status.describe()},
                 {"seconds", watch.ms() / 1000},
                 {"frames", e->stamps.size()}};
-    if (status.exited && status.code == 124) {
+    // timeout exits 124 when its TERM ended the command; a command that ignores TERM is
+    // killed 5 s later together with timeout itself (its whole process group).
+    const bool killed_at_limit =
+        !status.exited && status.signal == SIGKILL && watch.ms() / 1000 >= e->options.timeout_s;
+    if ((status.exited && status.code == 124) || killed_at_limit) {
       r.record["status"] = "timeout";
       r.warning = fmt::format("external VO '{}': no result within timeout_s = {} s", r.name,
                               e->options.timeout_s);

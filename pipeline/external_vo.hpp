@@ -54,7 +54,8 @@ class ExternalVoStage {
 };
 
 /// The command with its placeholders ({dir}, {root}, {out}, {driftlab}) replaced by these
-/// values, each quoted for /bin/sh; UserError naming an unknown {placeholder}.
+/// values, each quoted for /bin/sh; UserError naming an unknown {placeholder}. Other text in
+/// braces ("${HOME}", "{ print $1 }") is the shell's and stays as written.
 std::string expand_command(const std::string& command, const std::filesystem::path& dir,
                            const std::filesystem::path& root, const std::filesystem::path& out,
                            const std::filesystem::path& driftlab);

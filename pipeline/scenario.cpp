@@ -45,6 +45,36 @@ std::string where_key(const YAML::Node& root, const std::string& label,
   return fmt::format("{}:{}:{}", label, mark.line + 1, mark.column + 1);
 }
 
+// `message` (about the key path it starts with, e.g. "pipeline.fusion: got ..." or
+// "mission.waypoints_ne_m[3]: ...") prefixed with "FILE:LINE:COL" of the deepest part of that
+// path the file gives; as it was when the file gives none of it (a default, or a --set).
+std::string located(const YAML::Node& root, const std::string& label, const std::string& message) {
+  const std::string path = message.substr(0, message.find_first_of(" :"));
+  YAML::Node node;
+  node.reset(root);
+  YAML::Mark mark = YAML::Mark::null_mark();
+  std::size_t start = 0;
+  while (start <= path.size()) {
+    const std::size_t dot = std::min(path.find('.', start), path.size());
+    const std::string part = path.substr(start, dot - start);
+    const std::size_t bracket = part.find('[');
+    const std::string key = part.substr(0, bracket);
+    if (key.empty() || !node.IsMap() || !node[key]) break;
+    node.reset(node[key]);
+    mark = node.Mark();
+    std::uint64_t index = 0;
+    if (bracket != std::string::npos && node.IsSequence() &&
+        yaml::parse_uint64(part.substr(bracket + 1, part.size() - bracket - 2), &index) &&
+        index < node.size()) {
+      node.reset(node[index]);
+      mark = node.Mark();
+    }
+    start = dot + 1;
+  }
+  if (mark.is_null()) return message;
+  return fmt::format("{}:{}:{}: {}", label, mark.line + 1, mark.column + 1, message);
+}
+
 // Reads "north_m,east_m" lines ('#' comments, blank lines and an optional
 // header as the first line that is neither).
 std::vector<std::array<double, 2>> read_waypoints_csv(const std::filesystem::path& path,
@@ -107,7 +137,7 @@ void resolve_files(Scenario* s, const YAML::Node& root, const std::string& label
 
 }  // namespace
 
-void validate_scenario(const Scenario& s, const std::string& label) {
+std::vector<std::string> scenario_problems(const Scenario& s) {
   const std::string problems = yaml::validate(s);
   yaml::ErrorList errors;
   if (!problems.empty()) errors.add(problems);
@@ -152,6 +182,12 @@ void validate_scenario(const Scenario& s, const std::string& label) {
         clock.offset_ms, clock.jitter_ms, stamp_error_s, s.eval.association_tolerance_s));
   if (errors.empty())  // combinations only once every value is in range
     for (const std::string& problem : impossible_combinations(s)) errors.add(problem);
+  return errors.messages();
+}
+
+void validate_scenario(const Scenario& s, const std::string& label) {
+  yaml::ErrorList errors;
+  for (const std::string& problem : scenario_problems(s)) errors.add(problem);
   errors.throw_if_any(label + ": invalid scenario:");
 }
 
@@ -166,7 +202,9 @@ Scenario parse_scenario(const std::string& text, const std::string& label,
     yaml::read_into(doc, {"--set " + assignment, false}, &s, /*check_rules=*/false);
   }
   resolve_files(&s, root, label, base_dir);
-  validate_scenario(s, label);
+  yaml::ErrorList errors;
+  for (const std::string& problem : scenario_problems(s)) errors.add(located(root, label, problem));
+  errors.throw_if_any(label + ": invalid scenario:");
   return s;
 }
 

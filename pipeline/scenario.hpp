@@ -41,7 +41,11 @@ constexpr auto enum_table(FusionAlgorithm) {
                     std::pair{FusionAlgorithm::kEskf, "eskf"}};
 }
 
-/// Which stages run.
+/// The first word in braces of an external VO's command that is not one of its placeholders
+/// ({dir}, {root}, {out}, {driftlab}), e.g. "{outt}"; empty when there is none. "${HOME}" and
+/// braces around anything but one word ("{ print $1 }") are the shell's.
+std::string unknown_command_placeholder(const std::string& command);
+
 /// A VO of the user's, run as a command on an export of the run's own frames (issue 17).
 struct ExternalVoOptions {
   std::string name;
@@ -61,8 +65,13 @@ struct ExternalVoOptions {
       "Shell command (/bin/sh -c) run once the frames are exported; placeholders: {dir} the "
       "dataset (KITTI: its sequence folder with calib.txt; EuRoC and TUM: the folder holding "
       "mav0/ or rgb.txt), {root} the export's root (info.yaml), {out} the trajectory file the "
-      "command must write, {driftlab} this driftlab executable",
+      "command must write, {driftlab} this driftlab executable. Any other word in braces is an "
+      "error; ${VAR} and braces around anything but one word are the shell's",
       yaml::non_empty());
+    const std::string unknown = unknown_command_placeholder(command);
+    a.require(unknown.empty(), "command",
+              "placeholders {dir}, {root}, {out} or {driftlab} only, not " + unknown +
+                  " (a word in braces is a placeholder; ${VAR} is the shell's)");
     a("format", format, "Layout of the export the command reads (driftlab export --format)");
     a("output", output,
       "Format of the trajectory the command writes at {out}: tum or kitti (left-camera poses, "
@@ -79,6 +88,7 @@ struct ExternalVoOptions {
   }
 };
 
+/// Which stages run, and the options of each algorithm.
 struct PipelineOptions {
   std::vector<std::string> vo{"sparse"};
   std::vector<FusionAlgorithm> fusion{FusionAlgorithm::kCaSmoother};
@@ -177,7 +187,12 @@ Scenario parse_scenario(const std::string& text, const std::string& label,
                         const std::filesystem::path& base_dir,
                         const std::vector<std::string>& overrides = {});
 
-/// Checks the rules that span sections or need the file system; throws UserError.
+/// What breaks the rules that span sections (one message each, starting with the key path);
+/// empty when the scenario can run.
+std::vector<std::string> scenario_problems(const Scenario& scenario);
+
+/// Throws UserError with every problem of scenario_problems(), under "LABEL: invalid scenario:".
+/// (parse_scenario() and load_scenario() check the same, and say where in the file.)
 void validate_scenario(const Scenario& scenario, const std::string& label);
 
 /// The resolved scenario as YAML: every key, defaults filled in, doc comments.

@@ -373,12 +373,28 @@ TEST(CliEval, BadInputFailsAndLeavesNothing) {
                       (dir / "unsorted.tum").string(), "--out", (dir / "out").string()});
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.err.find("unsorted.tum"), std::string::npos) << r.err;
+  // A bad option value is a bad command line (exit 2), named by the flag as given.
   r = run_cli({"eval", "--gt", (dir / "gt.tum").string(), "--est", (dir / "est.tum").string(),
                "--align", "procrustes", "--out", (dir / "out").string()});
-  EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_NE(r.err.find("align: got 'procrustes', expected one of: horn, se3, sim3, posyaw, none"),
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.err.find("--align procrustes: align: got 'procrustes', expected one of: horn, se3, "
+                       "sim3, posyaw, none"),
             std::string::npos)
       << r.err;
+  r = run_cli({"eval", "--gt", (dir / "gt.tum").string(), "--est", (dir / "est.tum").string(),
+               "--section-length", "-1", "--out", (dir / "out").string()});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.err.find("--section-length -1: section_length_m: got -1"), std::string::npos)
+      << r.err;
+  r = run_cli({"eval", "--gt", (dir / "gt.tum").string(), "--est", (dir / "est.tum").string(),
+               "--format", "ply", "--out", (dir / "out").string()});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.err.find("--format: unknown trajectory format: got 'ply'"), std::string::npos)
+      << r.err;
+  r = run_cli({"export", (kSource / "scenarios/river_crossing.yaml").string(), "--format", "kiti",
+               "--out", (dir / "out").string()});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.err.find("--format: unknown dataset format: got 'kiti'"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out"));
   fs::remove_all(dir);
 }

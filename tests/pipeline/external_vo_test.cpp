@@ -34,6 +34,30 @@ TEST(ExternalVo, CommandPlaceholdersAreQuotedAndUnknownOnesRejected) {
     EXPECT_NE(std::string(e.what()).find("got '{calib}', expected placeholders"), std::string::npos)
         << e.what();
   }
+  // The shell's braces stay as written: ${VAR} and anything but one word in braces.
+  EXPECT_EQ(expand_command("echo ${HOME} | awk '{ print $1 }' > {out}; f() { :; }", "/d", "/r",
+                           "/o", "/x"),
+            "echo ${HOME} | awk '{ print $1 }' > '/o'; f() { :; }");
+  EXPECT_EQ(expand_command("{out}{dir}{", "/d", "/r", "/o", "/x"), "'/o''/d'{");
+  EXPECT_EQ(unknown_command_placeholder("a {dir} ${x} { y } {outt} {z}"), "{outt}");
+  EXPECT_EQ(unknown_command_placeholder("a {dir} ${x} { y } {out}"), "");
+}
+
+TEST(ExternalVo, AnUnknownPlaceholderIsAScenarioErrorWithItsLine) {
+  // Found when the scenario is read, not after the frame loop.
+  try {
+    parse_scenario(
+        "name: x\npipeline:\n  external_vo:\n    - name: a\n      command: 'myvo {outt}'\n",
+        "t.yaml", ".");
+    FAIL() << "no error";
+  } catch (const UserError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("t.yaml:5:"), std::string::npos) << what;
+    EXPECT_NE(what.find("command: got 'myvo {outt}', expected placeholders {dir}, {root}, {out} "
+                        "or {driftlab} only, not {outt}"),
+              std::string::npos)
+        << what;
+  }
 }
 
 TEST(ExternalVo, NamesMustBeNewUniqueAndFileSafe) {
@@ -72,7 +96,9 @@ TEST(ExternalVo, RealFailingHangingAndGarbageCommandsAreEachRecorded) {
       "[{name: mine, command: '" + script("driftlab_sparse.sh") +
       " {driftlab} {dir} {root} {out}'}, {name: broken, command: '" + script("exit1.sh") +
       " {dir}'}, {name: stuck, command: '" + script("hang.sh") +
-      "', timeout_s: 1}, {name: junk, command: '" + script("garbage.sh") +
+      "', timeout_s: 1}, {name: deaf, command: \"trap '' TERM; sleep 300\", timeout_s: 1}, "
+      "{name: junk, command: '" +
+      script("garbage.sh") +
       " {out}'}, {name: mine_euroc, format: euroc, output: tum, command: 'test -f "
       "{dir}/mav0/imu0/data.csv && test -f {dir}/mav0/state_groundtruth_estimate0/data.csv && "
       "cp {root}/../../mine/trajectory.tum {out}'}]";
@@ -93,11 +119,14 @@ TEST(ExternalVo, RealFailingHangingAndGarbageCommandsAreEachRecorded) {
   EXPECT_NE(ext["broken"]["log_tail"].get<std::string>().find("permission denied"),
             std::string::npos);
   EXPECT_EQ(ext["stuck"]["status"], "timeout");
+  // Deaf to timeout's TERM: killed 5 s later, timeout with it.
+  EXPECT_EQ(ext["deaf"]["status"], "timeout");
+  EXPECT_EQ(ext["deaf"]["exit"], "killed by signal 9 (Killed)");
   EXPECT_EQ(ext["junk"]["status"], "bad output");
   EXPECT_NE(ext["junk"]["message"].get<std::string>().find("expected 8 columns"),
             std::string::npos);
   const std::string warnings = m["warnings"].dump();
-  for (const char* name : {"'broken'", "'stuck'", "'junk'"})
+  for (const char* name : {"'broken'", "'stuck'", "'deaf'", "'junk'"})
     EXPECT_NE(warnings.find(name), std::string::npos) << name;
   // The real VO behind the command is driftlab's sparse VO on the export: the built-in estimate.
   EXPECT_TRUE(m["algorithms"].contains("mine"));

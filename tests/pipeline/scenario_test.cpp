@@ -166,6 +166,25 @@ TEST(Scenario, CrossSectionRules) {
             std::string::npos);
 }
 
+TEST(Scenario, CrossSectionErrorsSayWhereInTheFile) {
+  // At the deepest part of the message's key path that the file gives.
+  EXPECT_NE(error_of("name: x\npipeline:\n  vo: []\n  fusion: [ca_smoother]\n")
+                .find("s.yaml:4:11: pipeline.fusion: got filters but no VO to feed them"),
+            std::string::npos)
+      << error_of("name: x\npipeline:\n  vo: []\n  fusion: [ca_smoother]\n");
+  EXPECT_NE(error_of("name: x\nmission:\n  type: waypoints\n")
+                .find("s.yaml:3:3: mission.waypoints_ne_m: got 0 waypoints"),
+            std::string::npos);
+  EXPECT_NE(error_of("mission: {type: waypoints, waypoints_ne_m: [[0, 0], [5, 30]]}\n")
+                .find("s.yaml:1:53: mission.waypoints_ne_m[1]: got (5, 30), expected a point on"),
+            std::string::npos)
+      << error_of("mission: {type: waypoints, waypoints_ne_m: [[0, 0], [5, 30]]}\n");
+  // Nothing of the path in the file (a --set): the message as it was, under the file's name.
+  const std::string set = error_of("name: x\n", {"pipeline.vo=[]"});
+  EXPECT_NE(set.find("s.yaml: invalid scenario:\npipeline.fusion: got filters"), std::string::npos)
+      << set;
+}
+
 // Miche's limit H / lambda <= 0.142 tanh(k d), computed here on its own: in 100 m of water a
 // 10 m wave is deep-water (tanh(k d) = 1 to 1e-27), so 1.40 m stands and 1.45 m breaks; in
 // 0.5 m of water tanh(k d) = tanh(0.1 pi) = 0.3042 lowers the limit to a 0.432 m wave. Such a
