@@ -1,11 +1,27 @@
 #include "app/cli_main.hpp"
 
+#include <algorithm>
 #include <iostream>
+#include <string_view>
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 
 namespace driftlab::app {
+namespace {
+
+// "error: " before each line of `what`, as compilers do: every problem of a file, one per line,
+// each found by a search for "error:".
+void print_error(const char* what) {
+  std::string_view text(what);
+  while (!text.empty()) {
+    const std::size_t end = std::min(text.find('\n'), text.size());
+    std::cerr << "error: " << text.substr(0, end) << "\n";
+    text.remove_prefix(std::min(end + 1, text.size()));
+  }
+}
+
+}  // namespace
 
 int run_cli_main(CLI::App& app, int argc, char** argv, const std::function<int()>& dispatch) {
   try {
@@ -17,13 +33,14 @@ int run_cli_main(CLI::App& app, int argc, char** argv, const std::function<int()
   try {
     return dispatch();
   } catch (const UsageError& e) {
-    std::cerr << "error: " << e.what() << "\nRun with --help for more information.\n";
+    print_error(e.what());
+    std::cerr << "Run with --help for more information.\n";
     return kExitUsage;
   } catch (const Unavailable& e) {
     std::cerr << "driftlab: not available in this build yet: " << e.what() << "\n";
     return kExitUnavailable;
   } catch (const UserError& e) {
-    std::cerr << "error: " << e.what() << "\n";
+    print_error(e.what());
     return kExitUserError;
   } catch (const std::exception& e) {
     std::cerr << "driftlab: internal error: " << e.what() << "\n";

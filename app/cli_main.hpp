@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <charconv>
+#include <cstdint>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -44,6 +46,19 @@ auto as_usage_error(std::string_view flag, F&& f) -> decltype(f()) {
     throw UsageError(flag.empty() ? std::string(e.what())
                                   : std::string(flag) + ": " + std::string(e.what()));
   }
+}
+
+/// CLI11 check of a seed option: a non-negative integer (as the scenario's `seed`).
+inline CLI::Validator seed_check() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::uint64_t value = 0;
+        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+        if (text.empty() || error != std::errc() || end != text.data() + text.size())
+          return "got '" + text + "', expected a non-negative integer";
+        return "";
+      },
+      "SEED");
 }
 
 /// Parses argv into `app` and runs `dispatch`, mapping a bad command line to kExitUsage (after

@@ -1,17 +1,31 @@
 #include "app/dataset_commands.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "app/cli_main.hpp"
 #include "core/error.hpp"
 #include "pipeline/dataset_run.hpp"
 #include "pipeline/export_stage.hpp"
 #include "pipeline/scenario.hpp"
+#include "vo/registry.hpp"
 
 namespace driftlab::app {
+namespace {
+
+// For a CLI11 check: "" when `name` is one of `names`, else what was expected.
+std::string one_of(const std::string& name, const std::vector<std::string>& names) {
+  if (std::find(names.begin(), names.end(), name) != names.end()) return "";
+  return fmt::format("got '{}', expected one of: {}", name, fmt::join(names, ", "));
+}
+
+}  // namespace
 
 DatasetCommands::DatasetCommands(CLI::App& app) {
   export_ = app.add_subcommand(
@@ -21,9 +35,10 @@ DatasetCommands::DatasetCommands(CLI::App& app) {
       ->capture_default_str();
   export_->add_option("--out", out_, "Output folder (written atomically)")->required();
   export_->add_option("--sequence", sequence_, "KITTI sequence number")->capture_default_str();
-  export_->add_option("--frames", frames_, "Number of stereo frames (0 = the whole mission)");
+  export_->add_option("--frames", frames_, "Number of stereo frames (0 = the whole mission)")
+      ->check(CLI::NonNegativeNumber);
   export_->add_option("--set", sets_, "Override a key: KEY.PATH=VALUE (repeatable)");
-  export_->add_option("--seed", seed_, "Override the scenario seed");
+  export_->add_option("--seed", seed_, "Override the scenario seed")->check(seed_check());
   export_->add_flag("--force", force_, "Replace an existing output folder");
 
   vo_ = app.add_subcommand(
@@ -31,20 +46,31 @@ DatasetCommands::DatasetCommands(CLI::App& app) {
   vo_->add_option("DATASET", dataset_, "Dataset folder")->required();
   vo_->add_option("--format", format_, "Dataset layout: kitti or euroc")->capture_default_str();
   vo_->add_option("--algo", algos_, "VO algorithms (default: the settings' pipeline.vo)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(CLI::Validator(
+          [](std::string& name) { return one_of(name, vo::available_vo_names()); }, "NAME"));
   vo_->add_option("--fusion", fusion_,
                   "Filters following each VO: ca_smoother, eskf, ned_kf, ned_pf, or none "
                   "(default: the settings' pipeline.fusion; eskf needs the dataset's IMU, the "
                   "NED filters a compass)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(CLI::Validator(
+          [](std::string& name) {
+            std::vector<std::string> names{"none"};
+            for (const auto& [value, text] : enum_table(pipeline::FusionAlgorithm{}))
+              names.emplace_back(text);
+            return one_of(name, names);
+          },
+          "NAME"));
   vo_->add_option("--out", out_, "Output folder (written atomically)")->required();
   vo_->add_option("--sequence", sequence_, "KITTI sequence number")->capture_default_str();
   vo_->add_option("--settings", settings_,
                   "Scenario file whose pipeline (VO options), eval and seed are used (default: "
                   "the built-in defaults; an export's scenario.resolved.yaml reproduces its run)");
   vo_->add_option("--set", sets_, "Override a key of the settings: KEY.PATH=VALUE (repeatable)");
-  vo_->add_option("--seed", seed_, "Override the seed");
-  vo_->add_option("--frames", frames_, "Stop after this many stereo frames (0 = all)");
+  vo_->add_option("--seed", seed_, "Override the seed")->check(seed_check());
+  vo_->add_option("--frames", frames_, "Stop after this many stereo frames (0 = all)")
+      ->check(CLI::NonNegativeNumber);
   vo_->add_flag("--force", force_, "Replace an existing output folder");
 }
 

@@ -238,7 +238,8 @@ struct RunVerb : Pinned {
     scenario_opt = cmd->add_option("SCENARIO", file, "Scenario YAML file");
     out_opt = cmd->add_option("--out", out, "Output folder (written atomically)");
     cmd->add_option("--set", sets, "Override a key: KEY.PATH=VALUE (repeatable)");
-    cmd->add_option("--seed", seed, "Override the scenario seed");
+    cmd->add_option("--seed", seed, "Override the scenario seed")
+        ->check(driftlab::app::seed_check());
     cmd->add_flag("--force", force, "Replace an existing output folder");
     cmd->add_flag("--only-motion", only_motion,
                   "Stop after the physics stage (body_groundtruth.csv, groundtruth.tum)");
@@ -265,7 +266,8 @@ struct RenderVerb : Pinned {
     cmd = app.add_subcommand("render", "Render the stereo sequence of a scenario to PNG files");
     cmd->add_option("SCENARIO", file, "Scenario YAML file")->required();
     cmd->add_option("--out", out, "Output folder")->required();
-    cmd->add_option("--frames", frames, "Number of stereo frames (0 = all)");
+    cmd->add_option("--frames", frames, "Number of stereo frames (0 = all)")
+        ->check(CLI::NonNegativeNumber);
     cmd->add_flag("--depth", depth, "Also write ground-truth depth (depth/NNNNNN.pfm)");
     cmd->add_option("--set", sets, "Override a key: KEY.PATH=VALUE (repeatable)");
     cmd->add_flag("--force", force, "Replace an existing output folder");

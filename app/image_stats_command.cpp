@@ -11,6 +11,7 @@
 #include <iostream>
 #include <string_view>
 
+#include "app/cli_main.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "dataset/dataset.hpp"
@@ -76,14 +77,14 @@ eval::ImageStatsOptions parse_size(const std::string& size) {
   };
   const std::string_view whole(size);
   if (x == std::string::npos || !digits(whole.substr(0, x)) || !digits(whole.substr(x + 1)))
-    throw UserError(fmt::format("imagestats: --size: got '{}'; expected WIDTHxHEIGHT", size));
+    throw UsageError(fmt::format("--size: got '{}', expected WIDTHxHEIGHT", size));
   o.width_px = std::stoi(size.substr(0, x));
   o.height_px = std::stoi(size.substr(x + 1));
   if (o.width_px < 200 || o.height_px < 150)
-    throw UserError(fmt::format(
-        "imagestats: --size: got {}; expected at least 200x150 (the mirror search compares "
-        "{} rows either side of a waterline)",
-        size, o.mirror_axis_depth_px));
+    throw UsageError(
+        fmt::format("--size: got {}, expected at least 200x150 (the mirror search compares "
+                    "{} rows either side of a waterline)",
+                    size, o.mirror_axis_depth_px));
   o.spectrum_min_cycles_px = 8.0 / o.height_px;
   return o;
 }
@@ -177,9 +178,8 @@ int ImageStatsCommand::run() const {
   if (!montage_.empty()) {
     const std::string ext = fs::path(montage_).extension().string();
     if (ext != ".png" && ext != ".jpg" && ext != ".jpeg")
-      throw UserError(fmt::format(
-          "imagestats: --montage: got '{}'; expected a name ending in .png, .jpg or .jpeg",
-          montage_));
+      throw UsageError(fmt::format(
+          "--montage: got '{}', expected a name ending in .png, .jpg or .jpeg", montage_));
   }
   std::vector<Input> inputs;
   for (const auto& arg : inputs_) inputs.push_back(collect(arg, per_folder_));

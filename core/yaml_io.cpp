@@ -29,6 +29,7 @@ Check Check::operator&(const Check& o) const {
   c.max_size = std::min(c.max_size, o.max_size);
   c.non_empty_string = c.non_empty_string || o.non_empty_string;
   if (o.choices) c.choices = o.choices;
+  if (o.text_rule) c.text_rule = o.text_rule;
   if (!o.why.empty()) c.why = c.why.empty() ? o.why : c.why + "; " + o.why;
   c.required = c.required || o.required;
   if (!o.expected.empty()) c.expected = o.expected;

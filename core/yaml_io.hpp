@@ -69,6 +69,9 @@ struct Check {
   /// Strings (and the strings of a list) must be one of these names, asked for when the
   /// value is checked: a list that grows at run time (e.g. the VOs a program registers).
   std::function<std::vector<std::string>()> choices{};
+  /// A rule on a string's text: "" when it holds, else what is expected, in words (e.g. the
+  /// placeholders a command may hold). Checked as the value is read, like `choices`.
+  std::function<std::string(const std::string&)> text_rule{};
   /// Why the bounds are what they are (a plausible range's reason), shown after them in
   /// messages and in the reference.
   std::string why{};
@@ -108,6 +111,10 @@ inline Check size_between(std::size_t lo, std::size_t hi) {
 inline Check non_empty() { return {.min_size = 1, .non_empty_string = true}; }
 inline Check one_of(std::function<std::vector<std::string>()> names) {
   return {.choices = std::move(names)};
+}
+/// A string must satisfy `rule` (see Check::text_rule).
+inline Check text_rule(std::function<std::string(const std::string&)> rule) {
+  return {.text_rule = std::move(rule)};
 }
 /// The key must be given; `expected` says what in words.
 inline Check required(std::string expected) {
@@ -490,6 +497,11 @@ void Reader::read_value(const YAML::Node& node, const std::string& key_path, T& 
       fail(node, key_path, "'" + text + "'", expected);
       return;
     }
+    if (const std::string expected = check.text_rule ? check.text_rule(text) : "";
+        !expected.empty()) {
+      fail(node, key_path, "'" + text + "'", expected);
+      return;
+    }
     value = text;
   } else if constexpr (Enum<T>) {
     const std::string expected = "one of: " + enum_choices<T>();
@@ -751,6 +763,8 @@ void Validator::check_value(const std::string& key_path, const T& value, const C
       errors_->add(key_path + ": got an empty string, expected a non-empty string");
     else if (const std::string expected = unknown_choice(check, value); !expected.empty())
       errors_->add(key_path + ": got '" + value + "', expected " + expected);
+    else if (const std::string rule = check.text_rule ? check.text_rule(value) : ""; !rule.empty())
+      errors_->add(key_path + ": got '" + value + "', expected " + rule);
   } else if constexpr (is_std_vector<T>::value || is_std_array<T>::value) {
     if (value.size() < check.min_size || value.size() > check.max_size) {
       Check size_only{.min_size = check.min_size, .max_size = check.max_size};

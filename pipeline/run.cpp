@@ -85,7 +85,10 @@ SE3 camera_mount_T_B_C(const sim::MountOptions& mount) {
 double motion_end_s(const Scenario& sc) {
   double end_s = sc.mission.duration_s;
   if (sc.pipeline.max_frames > 0) {
-    const double frames_s = (sc.pipeline.max_frames - 1) / sc.sensors.camera.rate_hz;
+    // The last frame's time; for one frame (t = 0) one physics step, as an end of 0 means none.
+    const double frames_s = sc.pipeline.max_frames > 1
+                                ? (sc.pipeline.max_frames - 1) / sc.sensors.camera.rate_hz
+                                : 1.0 / sc.vessel.physics_rate_hz;
     end_s = end_s > 0 ? std::min(end_s, frames_s) : frames_s;
   }
   return end_s > 0 ? end_s : sim::MotionOptions{}.hard_limit_s;

@@ -46,8 +46,9 @@ std::string where_key(const YAML::Node& root, const std::string& label,
 }
 
 // `message` (about the key path it starts with, e.g. "pipeline.fusion: got ..." or
-// "mission.waypoints_ne_m[3]: ...") prefixed with "FILE:LINE:COL" of the deepest part of that
-// path the file gives; as it was when the file gives none of it (a default, or a --set).
+// "mission.waypoints_ne_m[3]: ...") prefixed with "FILE:LINE:COL" of that key in the file; as it
+// was when the file does not give the key (a default, or a --set: a parent's line would point
+// at what the user did not write).
 std::string located(const YAML::Node& root, const std::string& label, const std::string& message) {
   const std::string path = message.substr(0, message.find_first_of(" :"));
   YAML::Node node;
@@ -59,7 +60,7 @@ std::string located(const YAML::Node& root, const std::string& label, const std:
     const std::string part = path.substr(start, dot - start);
     const std::size_t bracket = part.find('[');
     const std::string key = part.substr(0, bracket);
-    if (key.empty() || !node.IsMap() || !node[key]) break;
+    if (key.empty() || !node.IsMap() || !node[key]) return message;
     node.reset(node[key]);
     mark = node.Mark();
     std::uint64_t index = 0;

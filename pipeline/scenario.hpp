@@ -67,11 +67,12 @@ struct ExternalVoOptions {
       "mav0/ or rgb.txt), {root} the export's root (info.yaml), {out} the trajectory file the "
       "command must write, {driftlab} this driftlab executable. Any other word in braces is an "
       "error; ${VAR} and braces around anything but one word are the shell's",
-      yaml::non_empty());
-    const std::string unknown = unknown_command_placeholder(command);
-    a.require(unknown.empty(), "command",
-              "placeholders {dir}, {root}, {out} or {driftlab} only, not " + unknown +
-                  " (a word in braces is a placeholder; ${VAR} is the shell's)");
+      yaml::non_empty() & yaml::text_rule([](const std::string& text) -> std::string {
+        const std::string unknown = unknown_command_placeholder(text);
+        if (unknown.empty()) return "";
+        return "placeholders {dir}, {root}, {out} or {driftlab} only, not " + unknown +
+               " (a word in braces is a placeholder; ${VAR} is the shell's)";
+      }));
     a("format", format, "Layout of the export the command reads (driftlab export --format)");
     a("output", output,
       "Format of the trajectory the command writes at {out}: tum or kitti (left-camera poses, "

@@ -229,8 +229,9 @@ struct CameraOptions {
               "auto_exposure", "a max_exposure_ms no longer than the frame period");
     a("calibration_error", calibration_error, "Stereo miscalibration (true rig vs nominal)");
     a("lens_distortion", lens_distortion, "Lens distortion and rectification of both images");
-    a.require(baseline_m + calibration_error.baseline_error_m > 0, "calibration_error",
-              "a true baseline (baseline_m + baseline_error_m) > 0");
+    // (A baseline_m <= 0 has its own message.)
+    a.require(baseline_m <= 0 || baseline_m + calibration_error.baseline_error_m > 0,
+              "calibration_error", "a true baseline (baseline_m + baseline_error_m) > 0");
     a("clock", clock, "Frame time stamps: offset, jitter, dropped frames");
     ClockOptions::require_ordered(a, clock, rate_hz);
   }

@@ -310,9 +310,43 @@ TEST(CliImageStats, CountsTheCornersOfACheckerboardAndNamesABadInput) {
   EXPECT_NE(bad.err.find("no images"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "t.md"));
   bad = run_cli({"imagestats", (dir / "board.pgm").string(), "--size", "100x50"});
-  EXPECT_EQ(bad.exit_code, 1) << bad.output;
-  EXPECT_NE(bad.err.find("--size: got 100x50; expected at least 200x150"), std::string::npos)
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;  // a bad command line
+  EXPECT_NE(bad.err.find("--size: got 100x50, expected at least 200x150"), std::string::npos)
       << bad.err;
+  fs::remove_all(dir);
+}
+
+TEST(Cli, OptionValuesAreCheckedBeforeAnyWorkAndExit2) {
+  const std::string crossing = (kSource / "scenarios/river_crossing.yaml").string();
+  const fs::path dir = fresh_temp_dir("option_values");
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"render", crossing, "--frames", "-3"}, "--frames: Value -3 not in range"},
+      {{"export", crossing, "--frames", "-3"}, "--frames: Value -3 not in range"},
+      {{"run", crossing, "--seed", "abc"}, "--seed: got 'abc', expected a non-negative integer"},
+      {{"vo", dir.string(), "--algo", "sparse,spars"},
+       "--algo: got 'spars', expected one of: sparse, sparse_kf, pnp, dense"},
+      {{"vo", dir.string(), "--fusion", "foo"},
+       "--fusion: got 'foo', expected one of: none, ca_smoother, ned_kf, ned_pf, eskf"}};
+  for (const auto& [args, message] : cases) {
+    std::vector<std::string> argv = args;
+    argv.insert(argv.end(), {"--out", (dir / "out").string()});
+    const Result r = run_cli(argv);
+    EXPECT_EQ(r.exit_code, 2) << args[0] << ": " << r.output;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out"));
+  }
+  fs::remove_all(dir);
+}
+
+TEST(CliRender, OneFrameIsOneFrame) {
+  // --frames 1 once meant the whole mission: the physics' end at the first frame, t = 0, read
+  // as "no end".
+  const fs::path dir = fresh_temp_dir("one_frame");
+  const Result r = run_cli({"render", (kSource / "scenarios/river_crossing.yaml").string(),
+                            "--frames", "1", "--out", (dir / "r").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.out.find("rendered 1 stereo pairs"), std::string::npos) << r.out;
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir / "r/left"), fs::directory_iterator{}), 1);
   fs::remove_all(dir);
 }
 

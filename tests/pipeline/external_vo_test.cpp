@@ -58,6 +58,18 @@ TEST(ExternalVo, AnUnknownPlaceholderIsAScenarioErrorWithItsLine) {
               std::string::npos)
         << what;
   }
+  // The same through --set, named by it.
+  try {
+    parse_scenario("name: x\n", "t.yaml", ".",
+                   {"pipeline.external_vo=[{name: a, command: 'x {outt}'}]"});
+    FAIL() << "no error";
+  } catch (const UserError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("--set pipeline.external_vo=[{name: a, command: 'x {outt}'}]: "
+                        "pipeline.external_vo[0].command: got 'x {outt}', expected placeholders"),
+              std::string::npos)
+        << what;
+  }
 }
 
 TEST(ExternalVo, NamesMustBeNewUniqueAndFileSafe) {

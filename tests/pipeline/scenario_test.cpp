@@ -166,14 +166,24 @@ TEST(Scenario, CrossSectionRules) {
             std::string::npos);
 }
 
+TEST(Scenario, ABadValueIsReportedOnceNotAgainByTheRulesOnIt) {
+  const std::string e = error_of("sensors:\n  camera:\n    baseline_m: -0.12\n");
+  EXPECT_NE(e.find("s.yaml:3:17: sensors.camera.baseline_m: got -0.12"), std::string::npos) << e;
+  EXPECT_EQ(e.find("calibration_error"), std::string::npos) << e;
+  EXPECT_NE(error_of("sensors: {camera: {calibration_error: {baseline_error_m: -0.2}}}\n")
+                .find("expected a true baseline (baseline_m + baseline_error_m) > 0"),
+            std::string::npos);
+}
+
 TEST(Scenario, CrossSectionErrorsSayWhereInTheFile) {
-  // At the deepest part of the message's key path that the file gives.
+  // At the key the message is about, where the file gives it.
   EXPECT_NE(error_of("name: x\npipeline:\n  vo: []\n  fusion: [ca_smoother]\n")
                 .find("s.yaml:4:11: pipeline.fusion: got filters but no VO to feed them"),
             std::string::npos)
       << error_of("name: x\npipeline:\n  vo: []\n  fusion: [ca_smoother]\n");
+  // A key the file does not give (a default, or a --set): no line, not a parent's.
   EXPECT_NE(error_of("name: x\nmission:\n  type: waypoints\n")
-                .find("s.yaml:3:3: mission.waypoints_ne_m: got 0 waypoints"),
+                .find("s.yaml: invalid scenario:\nmission.waypoints_ne_m: got 0 waypoints"),
             std::string::npos);
   EXPECT_NE(error_of("mission: {type: waypoints, waypoints_ne_m: [[0, 0], [5, 30]]}\n")
                 .find("s.yaml:1:53: mission.waypoints_ne_m[1]: got (5, 30), expected a point on"),
