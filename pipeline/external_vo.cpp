@@ -164,8 +164,9 @@ struct ExternalVoStage::Export {
   }
 };
 
-ExternalVoStage::ExternalVoStage(const Scenario& sc, const fs::path& run_dir)
-    : sc_(sc), run_dir_(run_dir) {
+ExternalVoStage::ExternalVoStage(const Scenario& sc, const fs::path& run_dir,
+                                 const fs::path& reported_dir)
+    : sc_(sc), run_dir_(run_dir), reported_dir_(reported_dir.empty() ? run_dir : reported_dir) {
   for (const auto& o : sc.pipeline.external_vo) {
     auto e = std::make_unique<Export>();
     e->options = o;
@@ -258,8 +259,18 @@ std::vector<ExternalVoResult> ExternalVoStage::finish(
             fmt::format("external VO '{}': its trajectory cannot be read: {}", r.name, err.what());
       }
     }
+    // The run's folder by the name it will have: the temporary one is gone after the run.
+    const auto reported = [&](std::string text) {
+      const std::string from = run_dir_.string(), to = reported_dir_.string();
+      for (std::size_t at = text.find(from); at != std::string::npos;
+           at = text.find(from, at + to.size()))
+        text.replace(at, from.size(), to);
+      return text;
+    };
+    r.warning = reported(r.warning);
+    r.record["command"] = reported(command);
     r.record["message"] = r.warning;
-    r.record["log_tail"] = log_tail(e->folder / "log.txt");
+    r.record["log_tail"] = reported(log_tail(e->folder / "log.txt"));
     if (!e->options.keep_dataset) fs::remove_all(e->root);
     results.push_back(std::move(r));
   }

@@ -35,7 +35,10 @@ struct ExternalVoResult {
 class ExternalVoStage {
  public:
   /// One export per sc.pipeline.external_vo entry, under run_dir/external/NAME/dataset.
-  ExternalVoStage(const Scenario& sc, const std::filesystem::path& run_dir);
+  /// `reported_dir`: the folder the run becomes (run_dir is its temporary name until the end),
+  /// as the commands, messages and logs in the record name it; empty: run_dir.
+  ExternalVoStage(const Scenario& sc, const std::filesystem::path& run_dir,
+                  const std::filesystem::path& reported_dir = {});
   ~ExternalVoStage();
   bool empty() const;
   /// Whether any export wants the true depth with each frame (TUM RGB-D).
@@ -49,7 +52,7 @@ class ExternalVoStage {
  private:
   struct Export;
   const Scenario& sc_;
-  std::filesystem::path run_dir_;
+  std::filesystem::path run_dir_, reported_dir_;
   std::vector<std::unique_ptr<Export>> exports_;
 };
 

@@ -415,7 +415,8 @@ nlohmann::json camera_metrics(const Scenario& sc, std::size_t frames, std::size_
 
 static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scene,
                               const SensorData& sensor_data, const MissionTruth& mission,
-                              const std::filesystem::path& dir, const RunOptions& options,
+                              const std::filesystem::path& dir,
+                              const std::filesystem::path& final_dir, const RunOptions& options,
                               RunSummary* summary, nlohmann::json* metrics) {
   const Trajectory& camera_gt = mission.camera_gt;
   const RngStreams rng(sc.seed);
@@ -426,7 +427,7 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   // Stage: render and camera effects (the scene built once, uploaded once), on a thread of
   // their own when the run has more than one.
   const int threads = run_threads(sc.pipeline.threads);
-  ExternalVoStage external(sc, dir);  // exports of the frames for the external VOs
+  ExternalVoStage external(sc, dir, final_dir);  // exports of the frames for the external VOs
   FrameSource source(sc, scene, mission.frames, stamps, threads, 4, external.wants_depth());
   (*metrics)["timing"]["threads"] = threads;
 
@@ -571,7 +572,8 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
                       (!sc.pipeline.vo.empty() || !sc.pipeline.external_vo.empty()) &&
                       !camera_gt.empty();
   if (run_vo)
-    run_vision_stages(sc, *scene, sensor_data, truth, dir.path(), options, &summary, &metrics);
+    run_vision_stages(sc, *scene, sensor_data, truth, dir.path(), dir.final_path(), options,
+                      &summary, &metrics);
 
   summary.total_s = seconds_since(t0);
   metrics["version"] = DRIFTLAB_VERSION;

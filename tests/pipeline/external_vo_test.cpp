@@ -135,6 +135,16 @@ TEST(ExternalVo, RealFailingHangingAndGarbageCommandsAreEachRecorded) {
   EXPECT_EQ(ext["deaf"]["status"], "timeout");
   EXPECT_EQ(ext["deaf"]["exit"], "killed by signal 9 (Killed)");
   EXPECT_EQ(ext["junk"]["status"], "bad output");
+  // Paths name the run's folder, not the temporary one it had until the end.
+  EXPECT_NE(
+      ext["mine"]["command"].get<std::string>().find((out / "external/mine/dataset").string()),
+      std::string::npos)
+      << ext["mine"]["command"];
+  EXPECT_NE(ext["junk"]["message"].get<std::string>().find(
+                (out / "external/junk/trajectory.tum").string() + ":1:"),
+            std::string::npos)
+      << ext["junk"]["message"];
+  EXPECT_EQ(m.dump().find(".tmp."), std::string::npos);
   EXPECT_NE(ext["junk"]["message"].get<std::string>().find("expected 8 columns"),
             std::string::npos);
   const std::string warnings = m["warnings"].dump();
