@@ -1,5 +1,5 @@
 // Writing results so that a failure never leaves a half-written file or run
-// directory behind (DESIGN.md "Errors"): write under a temporary name in the
+// directory behind (docs/design.md "Errors"): write under a temporary name in the
 // same directory, then rename into place, which POSIX makes atomic.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Error tiers (DESIGN.md "Style"): UserError for bad user input (a scenario, an
+// Error tiers (docs/design.md "Style"): UserError for bad user input (a scenario, an
 // asset, a trajectory file), InternalError for states that must never happen.
 // Library code throws; only app/ turns an exception into an exit code.
 #pragma once

@@ -1,5 +1,5 @@
 // Reading whole input files: one place for the checks and the messages that
-// every reader of outside input gives (DESIGN.md "Errors").
+// every reader of outside input gives (docs/design.md "Errors").
 #pragma once
 
 #include <filesystem>

@@ -1,4 +1,4 @@
-// Named, seeded random streams (DESIGN.md "Randomness"): every consumer of
+// Named, seeded random streams (docs/design.md "Randomness"): every consumer of
 // randomness draws from its own stream, derived from the scenario seed and the
 // stream's name, so adding or changing one sensor never shifts another's noise.
 //

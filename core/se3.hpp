@@ -1,5 +1,6 @@
 // Rigid-body transforms on Eigen: SO(3) helpers and the SE3 pose type.
-// A pose T_a_b maps points from frame b into frame a: p_a = T_a_b * p_b (DESIGN.md).
+// A pose T_a_b maps points from frame b into frame a: p_a = T_a_b * p_b (docs/design.md,
+// "Frames").
 #pragma once
 
 #include <Eigen/Core>

@@ -275,7 +275,8 @@ void append_values(std::string* out, std::initializer_list<double> values, char 
 }
 
 // What a writer emits must pass its reader; a NaN pose or a repeated stamp is a
-// bug upstream (the filters guard NaN, DESIGN.md), not a user error.
+// bug upstream (the filters guard NaN, docs/design.md "Non-finite values"), not a user
+// error.
 void demand_writable(const Trajectory& trajectory) {
   for (std::size_t i = 0; i < trajectory.size(); ++i) {
     const SE3& T = trajectory[i].T_W_C;

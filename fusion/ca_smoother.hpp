@@ -131,7 +131,7 @@ class ConstantAccelerationSmoother {
   /// Kalman gain of axis i at its last measurement update (Eq. (5)); zero before any.
   Eigen::Vector2d axis_gain(int i) const;
   /// Times a non-finite state or measurement was caught and the filter restarted from its
-  /// prior (never expected; counted for reports, as DESIGN.md asks).
+  /// prior (never expected; counted for reports, as docs/design.md asks).
   int nonfinite_guards() const { return nonfinite_guards_; }
 
  private:

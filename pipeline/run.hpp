@@ -1,5 +1,5 @@
 // One scenario run, stage by stage, into an output folder written atomically
-// (DESIGN.md, "Data contract of a run"). Stages are wired in as they land:
+// (docs/design.md, "Data contract of a run"). Stages are wired in as they land:
 // physics (vessel motion and ground truth) now; sensors, render, VO, fusion
 // and evaluation with their issues.
 #pragma once

@@ -1,8 +1,8 @@
 // The sensors stage of a run: IMU, GPS and compass measured from the same ground truth as the
-// cameras (sim/sensors), written as imu.csv, gps.csv and compass.csv (DESIGN.md data contract)
-// and kept for the filters. The IMU streams during the physics; GPS and compass wait for the
-// scene (its meshes hide satellites, its steel structures bend the magnetic field), so the
-// body states at their (few) sample times are kept until finish().
+// cameras (sim/sensors), written as imu.csv, gps.csv and compass.csv (docs/design.md, "Data
+// contract of a run") and kept for the filters. The IMU streams during the physics; GPS and
+// compass wait for the scene (its meshes hide satellites, its steel structures bend the
+// magnetic field), so the body states at their (few) sample times are kept until finish().
 #pragma once
 
 #include <filesystem>

@@ -1,5 +1,6 @@
 // The stereo visual odometry interface every VO implementation (sparse/, dense/, pnp/) follows.
-// A VO sees rectified stereo pairs and the rig only, never ground truth (DESIGN.md).
+// A VO sees rectified stereo pairs and the rig only, never ground truth (docs/design.md,
+// "Layers").
 #pragma once
 
 #include <span>

@@ -157,8 +157,9 @@ TEST(Cli, RunWritesAtomicallyAndRefusesToOverwrite) {
   fs::remove_all(dir);
 }
 
-// DESIGN.md: an interrupted run leaves nothing that looks complete. Kill a run in its frame
-// loop (SIGKILL: no handler can tidy up) and look at what is left.
+// docs/design.md, "Data contract of a run": an interrupted run leaves nothing that looks
+// complete. Kill a run in its frame loop (SIGKILL: no handler can tidy up) and look at what is
+// left.
 TEST(Cli, KilledRunLeavesNoOutputFolder) {
   const fs::path dir = fresh_temp_dir("killed");
   const fs::path out = dir / "out";

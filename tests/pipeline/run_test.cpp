@@ -247,7 +247,7 @@ TEST(Run, WholeDischargeMeasurementMission) {
 // The end-to-end acceptance run: a straight calm-water leg (16 m at 0.5 m/s
 // past the river reach, two 6.5 m sections; 263 frames at the Bumblebee2's
 // 8.2 Hz) through every stage, checked against the data contract of
-// DESIGN.md and for sane values, with the shipped defaults.
+// docs/design.md and for sane values, with the shipped defaults.
 TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   // The shipped river_crossing scenario (both sparse VOs, the smoother, every camera effect of
   // the defaults) on a straight calm leg: only the mission and its length are changed.
