@@ -62,6 +62,9 @@ StudyCommands::StudyCommands(CLI::App& app) {
                                  "Expand a sweep file into DIR/manifest.jsonl (one job per line)");
   plan_->add_option("SWEEP", sweep_file_, "Sweep YAML file (see docs/sweeps.md)")->required();
   plan_->add_option("--out", out_, "Sweep folder to create")->required();
+  plan_->add_option("--set", plan_sets_,
+                    "Override a key of every job: KEY.PATH=VALUE (repeatable; replaces the "
+                    "sweep file's set entry for that key)");
   plan_->add_flag("--force", force_,
                   "Replace a different plan in --out (finished runs with unchanged parameters "
                   "are kept)");
@@ -182,7 +185,8 @@ std::optional<int> StudyCommands::dispatch() {
 }
 
 int StudyCommands::plan() {
-  const pl::Sweep sweep = pl::load_sweep(sweep_file_);
+  pl::Sweep sweep = pl::load_sweep(sweep_file_);
+  pl::apply_sets(&sweep, plan_sets_);
   const pl::SweepPlan plan = pl::plan_sweep(sweep);
   const pl::PlanWriteSummary s = pl::write_plan(plan, out_, force_);
   std::cout << "planned " << s.brief() << "\n";

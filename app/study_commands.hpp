@@ -45,6 +45,7 @@ class StudyCommands {
   CLI::App* run_cmd_ = nullptr;
 
   std::string sweep_file_, dir_, out_, schema_out_;
+  std::vector<std::string> plan_sets_;  // sweep plan --set
   bool force_ = false;
   std::size_t parallel_ = 1;
   std::vector<std::string> covariates_, run_regressions_;

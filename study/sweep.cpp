@@ -369,4 +369,27 @@ Sweep load_sweep(const fs::path& file) {
   return parse_sweep(read_text_file(file, "sweep file"), file.string(), file.parent_path());
 }
 
+void apply_sets(Sweep* sweep, const std::vector<std::string>& assignments) {
+  for (const std::string& a : assignments) {
+    const auto eq = a.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw UserError(
+          fmt::format("--set {}: got no KEY.PATH before '=', expected KEY.PATH=VALUE", a));
+    const std::string key = a.substr(0, eq);
+    const std::string where = "--set " + a;
+    // A key the file fixes takes the command line's value; another joins the fixed ones.
+    std::size_t i = 0;
+    while (i < sweep->set.size() && sweep->set[i].first != key) ++i;
+    if (i == sweep->set.size()) {
+      sweep->set.emplace_back(key, "");
+      sweep->set_where.push_back(where);
+    }
+    sweep->set[i].second = a.substr(eq + 1);
+    sweep->set_where[i] = where;
+  }
+  yaml::ErrorList errors;
+  check_across_axes(*sweep, &errors);
+  errors.throw_if_any();
+}
+
 }  // namespace driftlab::study

@@ -85,6 +85,11 @@ Sweep load_sweep(const std::filesystem::path& file);
 /// The same from text; `label` names it in messages, relative paths resolve against `dir`.
 Sweep parse_sweep(const std::string& text, const std::string& label,
                   const std::filesystem::path& dir);
+/// Applies the command line's `--set KEY.PATH=VALUE` to every job: the value replaces the
+/// file's `set` entry for that key or joins them. A key that an axis sweeps, or `seed`, is an
+/// error naming the --set; key paths and values are checked against the base scenario by
+/// plan_sweep(), like the file's own.
+void apply_sets(Sweep* sweep, const std::vector<std::string>& assignments);
 /// The reference of every sweep-file key (Markdown), generated from the reader's own field
 /// list: `driftlab sweep schema`, docs/sweep-reference.md.
 std::string sweep_reference_markdown();

@@ -12,6 +12,9 @@
 #   OUT       the sweep folder to write      (default: a new temporary folder)
 #   JOBS      jobs at once                   (default: the number of cores)
 #   UPDATE    non-empty: accept the new values into BASELINE (driftlab regress --update)
+#   GATE_SET  space-separated KEY.PATH=VALUE overrides for every job (`sweep plan --set`), to
+#             try a change without editing code, e.g.
+#             GATE_SET="pipeline.sparse.lk_refinement=false" examples/ci/run-gate.sh
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 DRIFTLAB=${DRIFTLAB:-$here/../../build/bin/driftlab}
@@ -20,8 +23,11 @@ BASELINE=${BASELINE:-$here/baseline.json}
 OUT=${OUT:-$(mktemp -d "${TMPDIR:-/tmp}/driftlab-gate.XXXXXX")/sweep}
 JOBS=${JOBS:-$(nproc)}
 
+sets=()
+for kv in ${GATE_SET:-}; do sets+=(--set "$kv"); done
+
 start=$(date +%s)
-"$DRIFTLAB" sweep plan "$SWEEP" --out "$OUT"
+"$DRIFTLAB" sweep plan "$SWEEP" --out "$OUT" "${sets[@]}"
 "$DRIFTLAB" sweep run "$OUT" -j "$JOBS"
 "$DRIFTLAB" sweep merge "$OUT"
 set +e

@@ -124,6 +124,46 @@ axes:
   EXPECT_EQ(sc.water.waves.water_depth_m, 0.6);
 }
 
+// `sweep plan --set` (the gate's GATE_SET): the command line's value replaces the file's fixed
+// one or joins them, reaches every job's scenario, and may not fix a swept key or the seed.
+TEST(SweepPlan, CommandLineSetsReplaceOrJoinTheFixedOverrides) {
+  Sweep s = sweep_from(R"(
+base: tiny_base.yaml
+set:
+  water.waves.model: airy
+  water.waves.water_depth_m: 0.6
+axes:
+  - key: water.waves.airy.amplitude_m
+    values: [0.005, 0.0075]
+)");
+  apply_sets(&s, {"water.waves.water_depth_m=0.9", "water.waves.airy.wavelength_m=0.3"});
+  const SweepPlan plan = plan_sweep(s);
+  ASSERT_EQ(plan.jobs.size(), 2u);
+  const pipeline::Scenario sc =
+      pipeline::parse_scenario(plan.scenario_yaml, "scenario.yaml", kSweeps);
+  EXPECT_EQ(sc.water.waves.model, sim::WaveModel::kAiry);
+  EXPECT_EQ(sc.water.waves.water_depth_m, 0.9);
+  EXPECT_EQ(sc.water.waves.airy.wavelength_m, 0.3);
+  EXPECT_EQ(plan.info()["set"]["water.waves.water_depth_m"], 0.9);
+
+  const auto error_of = test::user_error_of;
+  const auto has = [](const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+  };
+  Sweep swept = s;
+  EXPECT_PRED2(has, error_of([&] { apply_sets(&swept, {"water.waves.airy.amplitude_m=0.1"}); }),
+               "--set water.waves.airy.amplitude_m=0.1: set.water.waves.airy."
+               "amplitude_m: also swept by axes[0]");
+  Sweep seeded = s;
+  EXPECT_PRED2(has, error_of([&] { apply_sets(&seeded, {"seed=3"}); }),
+               "--set seed=3: set.seed: got a fixed seed");
+  Sweep bad_key = s;
+  apply_sets(&bad_key, {"water.waves.no_such_key=1"});
+  EXPECT_PRED2(has, error_of([&] { plan_sweep(bad_key); }),
+               "--set water.waves.no_such_key=1: set.water.waves.no_such_key");
+  EXPECT_PRED2(has, error_of([&] { apply_sets(&bad_key, {"=1"}); }), "expected KEY.PATH=VALUE");
+}
+
 TEST(SweepPlan, RangeLinspaceAndLogspaceValues) {
   const Sweep s = sweep_from(R"(
 base: tiny_base.yaml
