@@ -42,6 +42,25 @@ bool is_finite(const SE3& T) {
   return T.translation().allFinite() && T.quaternion().coeffs().allFinite();
 }
 
+void end_without_motion(VoResult* result, std::string reason, SteadyClock::time_point t_start) {
+  result->valid = false;
+  result->reason = std::move(reason);
+  result->T_prev_curr = SE3();
+  result->mean_inlier_depth_m = 0.0;
+  result->times.total_ms = ms_since(t_start);
+}
+
+const char* end_with_motion(VoResult* result, const SE3& T_prev_curr, double mean_inlier_depth_m,
+                            SteadyClock::time_point t_start) {
+  if (!is_finite(T_prev_curr)) return "motion estimate not finite";
+  if (!std::isfinite(mean_inlier_depth_m)) return "mean depth not finite";
+  result->valid = true;
+  result->T_prev_curr = T_prev_curr;
+  result->mean_inlier_depth_m = mean_inlier_depth_m;
+  result->times.total_ms = ms_since(t_start);
+  return nullptr;
+}
+
 }  // namespace detail
 
 }  // namespace driftlab::vo

@@ -10,6 +10,7 @@
 
 #include "core/camera.hpp"
 #include "core/se3.hpp"
+#include "core/stopwatch.hpp"
 #include "core/time.hpp"
 
 namespace driftlab::vo {
@@ -109,6 +110,15 @@ void check_image(const cv::Mat& image, const PinholeCamera& camera, const char* 
                  const char* which);
 /// True when every number of T is finite.
 bool is_finite(const SE3& T);
+/// The end of a process() call without a motion: `result` invalid for `reason`, with the
+/// identity motion, no depth, and the call's total time since `t_start`.
+void end_without_motion(VoResult* result, std::string reason, SteadyClock::time_point t_start);
+/// The end of a process() call with a motion: `result` valid with T_prev_curr and the mean
+/// inlier depth, and the call's total time since `t_start`. Returns what makes that impossible
+/// ("motion estimate not finite", "mean depth not finite"; `result` untouched), nullptr when
+/// nothing does.
+const char* end_with_motion(VoResult* result, const SE3& T_prev_curr, double mean_inlier_depth_m,
+                            SteadyClock::time_point t_start);
 }  // namespace detail
 
 }  // namespace driftlab::vo

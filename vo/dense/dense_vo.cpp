@@ -219,13 +219,9 @@ VoResult DenseStereoOdometry::process(const StereoFrame& frame) {
   } advance{s};
 
   auto finish = [&](const char* reason) {
-    result.valid = false;
-    result.reason = reason;
-    result.T_prev_curr = SE3();
-    result.mean_inlier_depth_m = 0.0;
     s.has_velocity = false;
     result.times.estimate_ms = s.stats.align_ms;
-    result.times.total_ms = ms_since(t_start);
+    detail::end_without_motion(&result, reason, t_start);
     return result;
   };
 
@@ -251,16 +247,12 @@ VoResult DenseStereoOdometry::process(const StereoFrame& frame) {
       a.textured_inliers < s.options.min_inlier_fraction * a.textured_used)
     return finish("photometric residuals too large: the images do not align");
 
-  const SE3 T_prev_curr = aligned.T_curr_prev.inverse();
-  if (!detail::is_finite(T_prev_curr) || !std::isfinite(a.mean_inlier_depth_m))
-    return finish("motion estimate not finite");
-  result.valid = true;
-  result.T_prev_curr = T_prev_curr;
-  result.mean_inlier_depth_m = a.mean_inlier_depth_m;
+  result.times.estimate_ms = s.stats.align_ms;
+  if (const char* why = detail::end_with_motion(&result, aligned.T_curr_prev.inverse(),
+                                                a.mean_inlier_depth_m, t_start))
+    return finish(why);
   s.has_velocity = true;
   s.last_T_curr_prev = aligned.T_curr_prev;
-  result.times.estimate_ms = s.stats.align_ms;
-  result.times.total_ms = ms_since(t_start);
   return result;
 }
 

@@ -296,12 +296,8 @@ VoResult PnpStereoOdometry::process(const StereoFrame& frame) {
   } advance{s};
 
   auto finish = [&](const char* reason) {
-    result.valid = false;
-    result.reason = reason;
-    result.T_prev_curr = SE3();
-    result.mean_inlier_depth_m = 0.0;
     result.times.match_ms = match_ms;
-    result.times.total_ms = ms_since(t_start);
+    detail::end_without_motion(&result, reason, t_start);
     return result;
   };
 
@@ -331,15 +327,11 @@ VoResult PnpStereoOdometry::process(const StereoFrame& frame) {
   const cv::Vec3d& rvec = pose.rvec;
   const cv::Vec3d& tvec = pose.tvec;
   const SE3 T_curr_prev(so3_exp(Vec3(rvec[0], rvec[1], rvec[2])), Vec3(tvec[0], tvec[1], tvec[2]));
-  const SE3 T_prev_curr = T_curr_prev.inverse();
-  if (!detail::is_finite(T_prev_curr)) return finish("motion estimate not finite");
-  result.valid = true;
-  result.T_prev_curr = T_prev_curr;
   result.inliers = pose.inliers;
   s.stats.inliers = result.inliers;
-  result.mean_inlier_depth_m = s.mean_inlier_depth(T_curr_prev);
-  if (!std::isfinite(result.mean_inlier_depth_m)) return finish("mean depth not finite");
-  result.times.total_ms = ms_since(t_start);
+  if (const char* why = detail::end_with_motion(&result, T_curr_prev.inverse(),
+                                                s.mean_inlier_depth(T_curr_prev), t_start))
+    return finish(why);
   return result;
 }
 

@@ -305,12 +305,8 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   result.reference_frames_back = s.key_frames_back;
 
   auto finish = [&](std::string reason) {
-    result.valid = false;
-    result.reason = std::move(reason);
-    result.T_prev_curr = SE3();
-    result.mean_inlier_depth_m = 0.0;
     if (s.window_ba) s.window_ba->reset();  // the tracks break here
-    result.times.total_ms = ms_since(t_start);
+    detail::end_without_motion(&result, std::move(reason), t_start);
     return result;
   };
 
@@ -354,16 +350,14 @@ VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
     result.times.estimate_ms += ms_since(t);
   }
 
-  result.valid = true;
-  result.T_prev_curr = T_prev_curr;
   result.inliers = static_cast<int>(est.inliers->size());
-  result.mean_inlier_depth_m = s.flag_inliers(*est.inliers);
-  if (!std::isfinite(result.mean_inlier_depth_m)) return finish("mean depth not finite");
+  if (const char* why =
+          detail::end_with_motion(&result, T_prev_curr, s.flag_inliers(*est.inliers), t_start))
+    return finish(why);
   if (s.options.keyframes && s.keeps_keyframe(*est.inliers, T_ref_curr)) {
     advance.keep_reference = true;
     s.T_key_prev = T_ref_curr;
   }
-  result.times.total_ms = ms_since(t_start);
   return result;
 }
 
