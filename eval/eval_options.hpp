@@ -62,7 +62,7 @@ struct EvalOptions {
     a("align", align,
       "Alignment of estimate to ground truth before ATE. none: every estimate of driftlab run "
       "starts at the true first pose, so there is nothing to align; a rigid fit never turns "
-      "the estimate about a nearly straight track's axis (see the README)");
+      "the estimate about a nearly straight track's axis (see docs/evaluation.md)");
     a("align_first_n", align_first_n, "Align on the first N poses only (0 = whole track)",
       yaml::non_negative());
     a("association_tolerance_s", association_tolerance_s,

@@ -1,6 +1,6 @@
 // Descriptive statistics shared by every evaluation table.
 //
-// Conventions (documented in the README): `std_population` divides by n (as
+// Conventions (documented in docs/evaluation.md): `std_population` divides by n (as
 // evo's APE/RPE `std`, numpy ddof=0); `sd_sample` divides by n - 1 (as the
 // river paper's Table 1 "SD" and any statistics package). `rmse` is
 // sqrt(mean(x^2)), river paper Eq. (14).

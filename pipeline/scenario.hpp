@@ -121,7 +121,7 @@ struct PipelineOptions {
     a("fusion", fusion, "Filters and smoothers to run on the VO output");
     a("external_vo", external_vo,
       "VOs of your own, each a command run on an export of this run's frames and evaluated "
-      "with the built-in ones (README: External VOs)");
+      "with the built-in ones (docs/datasets.md: External VOs)");
     a("max_frames", max_frames, "Stop after this many stereo frames (0 = whole mission)",
       yaml::non_negative());
     a("threads", threads,
@@ -143,7 +143,7 @@ struct PipelineOptions {
     a("eskf", eskf, "Options of the error-state VO + IMU + GPS + compass filter");
     a("plugins", plugins,
       "Options of the VOs a program of your own registered with options, by name: "
-      "plugins.my_vo.KEY (vo/registry.hpp; README: Your VO in-process)");
+      "plugins.my_vo.KEY (vo/registry.hpp; docs/datasets.md: Your VO in-process)");
   }
 };
 

@@ -86,7 +86,8 @@ struct RiverReachOptions {
     a("texture_contrast", texture_contrast,
       "Contrast of procedural textures: scales each texture's deviation from its mean grey, "
       "clamped to [0, 255]. 2 gives frames whose spectrum slope, gradients and corners per "
-      "50x50 cell match four outdoor photographs (README, `driftlab imagestats`); 1 is the "
+      "50x50 cell match four outdoor photographs (docs/renderer-and-scenes.md, `driftlab "
+      "imagestats`); 1 is the "
       "textures as drawn",
       yaml::in_range(0, 4));
     a("bridge", bridge, "Road bridge with piers across each reach tile");

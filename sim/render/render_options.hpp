@@ -35,12 +35,14 @@ struct RenderOptions {
   void visit(A& a) {
     a("backend", backend, "OpenGL context backend");
     a("msaa_samples", msaa_samples,
-      "Multisample anti-aliasing samples (1 = off; 4 costs about 3x on llvmpipe, see README)",
+      "Multisample anti-aliasing samples (1 = off; 4 costs about 3x on llvmpipe, see "
+      "docs/renderer-and-scenes.md)",
       yaml::in_range(1, 16));
     a("reflection_resolution", reflection_resolution,
       "Size of the water's reflection pass: full (the camera's; mirror images move by their "
       "true sub-pixel amounts), half_height (full width, half the rows) or half (a quarter of "
-      "the fill, but the mirror image's motion snaps to steps of up to 2 px; see README)");
+      "the fill, but the mirror image's motion snaps to steps of up to 2 px; see "
+      "docs/renderer-and-scenes.md)");
     a("reflection_msaa_samples", reflection_msaa_samples,
       "Multisample anti-aliasing samples of the water's reflection pass (1 = off)",
       yaml::in_range(1, 16));

@@ -66,9 +66,9 @@ namespace driftlab::pipeline {
 namespace {
 
 TEST(FilterNoise, TheNedFiltersVoNoiseIsEstimatedByDefault) {
-  // The shipped choice (README: the seven basin experiments): ned_kf and ned_pf estimate the VO
-  // noise from the VO's results (null), and with_sensor_noise leaves it so; a number set by the
-  // user is kept.
+  // The shipped choice (docs/vo-and-filters.md: the seven basin experiments): ned_kf and ned_pf
+  // estimate the VO noise from the VO's results (null), and with_sensor_noise leaves it so; a
+  // number set by the user is kept.
   PipelineOptions defaults;
   defaults.ned_kf.vo_increment_noise_m = 0.002;
   const PipelineOptions p = with_sensor_noise(defaults, FilterMounts{});

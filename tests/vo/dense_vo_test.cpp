@@ -64,7 +64,7 @@ struct Worst {
 };
 
 // Runs a VO over a sequence and returns its worst per-frame errors against the true motions;
-// prints them (the numbers the README quotes).
+// prints them (the numbers docs/vo-and-filters.md quotes).
 Worst run(const Sequence& seq, const DenseVoOptions& options, const char* label) {
   DenseStereoOdometry vo(seq.rig, options, vo_rng());
   Worst w;

@@ -62,7 +62,7 @@ struct ErrorSummary {
 };
 
 // Runs a VO over a sequence, checks every frame after the first is valid and within the
-// targets, and prints what it achieved (the numbers the README quotes).
+// targets, and prints what it achieved (the numbers docs/vo-and-filters.md quotes).
 ErrorSummary run_and_check(const Sequence& seq, const PnpVoOptions& options, const char* label) {
   PnpStereoOdometry vo(seq.rig, options, vo_rng());
   ErrorSummary e;

@@ -72,7 +72,7 @@ struct SparseVoOptions {
   // that a few wrong stereo matches pull (a horizontal edge matched at the wrong disparity looks
   // 3.5 m away and barely moves): on the crossing's 1,970 rendered frames, 132 of the 270 frames of
   // one straight leg came out 4x short. At 1 px: track length -8.4 % -> +0.1 %, e'_p 0.092 ->
-  // 0.023 m/m (README).
+  // 0.023 m/m (docs/vo-and-filters.md).
   double inlier_threshold_px = 1.0;
   // Ours: Gauss-Newton on Eq. (2) converges quadratically, in ~6 iterations from no motion;
   // the tolerance is far below any pixel-level effect.
@@ -89,9 +89,10 @@ struct SparseVoOptions {
   // --- keyframes beyond the paper (the algorithm sparse_kf) -------------------------------------
   // Ours: at 0.17 m/s and 13 Hz a feature 20 m away moves 0.3 px per frame, below what
   // frame-to-frame matching resolves; matching against a keyframe until the image has moved
-  // enough makes the motion per estimate several pixels (see the README's river figures).
+  // enough makes the motion per estimate several pixels (see the river figures in
+  // docs/vo-and-filters.md).
   bool keyframes = false;              // paper: frame-to-frame
-  double keyframe_min_flow_px = 12.0;  // ours: chosen on river_crossing (README)
+  double keyframe_min_flow_px = 12.0;  // ours: chosen on river_crossing (docs/vo-and-filters.md)
   int keyframe_min_inliers = 40;       // ours: below this the keyframe's overlap is thinning
   int keyframe_max_frames = 60;        // ours: about 4.6 s at the river paper's 13 Hz
   // Ours: beyond ~10 % the near points' patches no longer match (forward runs, shared VO suite).
@@ -165,7 +166,7 @@ struct SparseVoOptions {
     a("inlier_threshold_px", inlier_threshold_px,
       "Largest reprojection error, in the left and in the right image, of an inlier [px] (ours: "
       "the Lucas-Kanade refined matches are good to ~0.05 px; libviso2's default, 2 px, lets "
-      "wrong stereo matches carry sub-pixel motions, see README)",
+      "wrong stereo matches carry sub-pixel motions, see docs/twin-vs-paper.md)",
       yaml::positive());
     a("gauss_newton_max_iterations", gauss_newton_max_iterations,
       "Iteration limit of each Gauss-Newton minimisation of Eq. (2)", yaml::in_range(1, 1000));
