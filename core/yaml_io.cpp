@@ -38,6 +38,14 @@ Check Check::operator&(const Check& o) const {
 
 bool Check::has_bounds() const { return std::isfinite(lo) || std::isfinite(hi); }
 
+std::string Check::out_of_range(double v) const {
+  const bool low = lo_open ? !(v > lo) : !(v >= lo);
+  const bool high = hi_open ? !(v < hi) : !(v <= hi);
+  if (!(low || high)) return "";
+  const Check bounds{.lo = lo, .hi = hi, .lo_open = lo_open, .hi_open = hi_open, .why = why};
+  return "a value " + bounds.describe();
+}
+
 std::string Check::describe() const {
   std::vector<std::string> parts;
   if (required) parts.push_back("required");
@@ -234,19 +242,13 @@ bool Reader::read_scalar_text(const YAML::Node& node, const std::string& key_pat
 
 void Reader::check_number(const YAML::Node& node, const std::string& key_path, double v,
                           const Check& check) {
-  const bool low = check.lo_open ? !(v > check.lo) : !(v >= check.lo);
-  const bool high = check.hi_open ? !(v < check.hi) : !(v <= check.hi);
-  if (!(low || high)) return;
+  const std::string expected = check.out_of_range(v);
+  if (expected.empty()) return;
   if (!check.expected.empty()) {
     fail(node, key_path, describe_node(node), check.expected);
     return;
   }
-  Check bounds{.lo = check.lo,
-               .hi = check.hi,
-               .lo_open = check.lo_open,
-               .hi_open = check.hi_open,
-               .why = check.why};
-  fail(node, key_path, format_double(v), "a value " + bounds.describe());
+  fail(node, key_path, format_double(v), expected);
 }
 
 YAML::Node Reader::value_of(std::string_view key) const {
@@ -537,17 +539,8 @@ void Validator::check_double(const std::string& key_path, double v, const Check&
     errors_->add(fmt::format("{}: got {}, expected a finite number", key_path, format_double(v)));
     return;
   }
-  const bool low = check.lo_open ? !(v > check.lo) : !(v >= check.lo);
-  const bool high = check.hi_open ? !(v < check.hi) : !(v <= check.hi);
-  if (low || high) {
-    Check bounds{.lo = check.lo,
-                 .hi = check.hi,
-                 .lo_open = check.lo_open,
-                 .hi_open = check.hi_open,
-                 .why = check.why};
-    errors_->add(fmt::format("{}: got {}, expected a value {}", key_path, format_double(v),
-                             bounds.describe()));
-  }
+  if (const std::string expected = check.out_of_range(v); !expected.empty())
+    errors_->add(fmt::format("{}: got {}, expected {}", key_path, format_double(v), expected));
 }
 
 void Validator::require(bool ok, const char* key, std::string_view expected) {

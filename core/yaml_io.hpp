@@ -86,6 +86,9 @@ struct Check {
   /// Human-readable description of what is expected, e.g. "> 0" or "in [0, 1]".
   std::string describe() const;
   bool has_bounds() const;
+  /// The range rule, written once for the reader and the validator: "" when `v` lies within
+  /// the bounds, else what is expected in words ("a value in [0, 1] (why)").
+  std::string out_of_range(double v) const;
 };
 
 inline Check none() { return {}; }
