@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/hash.hpp"
 
 // The bytes must not depend on whether a compiler fuses a * b + c into an FMA.
 // GCC in ISO mode (CMAKE_CXX_EXTENSIONS OFF) does not; clang does unless told.
@@ -15,8 +16,6 @@ namespace driftlab {
 namespace {
 
 constexpr std::uint64_t kGoldenGamma = 0x9e3779b97f4a7c15ULL;
-constexpr std::uint64_t kFnvOffset = 0xcbf29ce484222325ULL;
-constexpr std::uint64_t kFnvPrime = 0x100000001b3ULL;
 
 constexpr std::uint64_t mix64(std::uint64_t z) {
   z ^= z >> 30;
@@ -25,15 +24,6 @@ constexpr std::uint64_t mix64(std::uint64_t z) {
   z *= 0x94d049bb133111ebULL;
   z ^= z >> 31;
   return z;
-}
-
-constexpr std::uint64_t fnv1a64(std::string_view s) {
-  std::uint64_t h = kFnvOffset;
-  for (const char c : s) {
-    h ^= static_cast<std::uint8_t>(c);
-    h *= kFnvPrime;
-  }
-  return h;
 }
 
 }  // namespace

@@ -23,6 +23,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/hash.hpp"
+
 namespace driftlab::study {
 
 enum class SweepDesign { kGrid, kZip, kRandom };
@@ -141,8 +143,8 @@ SweepPlan plan_sweep(const Sweep& sweep);
 /// parameters, not by their noise).
 std::uint64_t replicate_seed(std::uint64_t sweep_seed, std::size_t replicate);
 
-/// FNV-1a 64 of `bytes` as 16 hex digits.
-std::string fnv1a64_hex(const std::string& bytes);
+/// FNV-1a 64 of `bytes` as 16 hex digits (core/hash.hpp).
+using driftlab::fnv1a64_hex;
 
 struct PlanWriteSummary {
   std::filesystem::path dir;

@@ -44,15 +44,6 @@ std::uint64_t replicate_seed(std::uint64_t sweep_seed, std::size_t replicate) {
          ((std::uint64_t{1} << 53) - 1);
 }
 
-std::string fnv1a64_hex(const std::string& bytes) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char c : bytes) {
-    h ^= c;
-    h *= 0x100000001b3ULL;
-  }
-  return fmt::format("{:016x}", h);
-}
-
 namespace {
 
 bool key_in_schema(const std::string& key) {

@@ -265,13 +265,6 @@ axes:
   EXPECT_EQ(defaulted.jobs[0].seed, derive_seed(7, "sweep.replicate.0") & ((1ULL << 53) - 1));
 }
 
-TEST(SweepPlan, Fnv1aMatchesPublishedVectors) {
-  // Test vectors of the FNV-1a 64-bit hash (Fowler, Noll, Vo reference test suite).
-  EXPECT_EQ(fnv1a64_hex(""), "cbf29ce484222325");
-  EXPECT_EQ(fnv1a64_hex("a"), "af63dc4c8601ec8c");
-  EXPECT_EQ(fnv1a64_hex("foobar"), "85944171f73967e8");
-}
-
 TEST(SweepPlan, HashIsThatOfTheResolvedScenarioAndStable) {
   const std::string text = R"(
 base: tiny_base.yaml
