@@ -1,7 +1,7 @@
-// An off-screen OpenGL 4.5 core context, with the gl* functions loaded by glad
-// through the backend's own GetProcAddress (immune to link order, see
-// PLATFORM-NOTES.md). Backends: OSMesa (Mesa llvmpipe on any CPU, the default)
-// and EGL (surfaceless or pbuffer: Mesa on a CPU, the vendor driver on a GPU).
+// An off-screen OpenGL 4.5 core context, with the gl* functions loaded by glad through the
+// backend's own GetProcAddress (immune to link order: with -lGL before -lOSMesa, plain gl*
+// calls resolve to glvnd and glGetString returns NULL). Backends: OSMesa (Mesa llvmpipe on any
+// CPU, the default) and EGL (surfaceless or pbuffer: Mesa on a CPU, the vendor driver on a GPU).
 #pragma once
 
 #include <memory>

@@ -1,6 +1,6 @@
 // The Slurm path of sweeps on a real, single-node Slurm cluster started by the
-// test (PLATFORM-NOTES.md, "Slurm on one machine"): munged with its own key,
-// slurmctld and slurmd on 127.0.0.1, every file under a temporary folder. A
+// test (Debian's slurm-wlm and munge, set up by the helpers below): munged with its own
+// key, slurmctld and slurmd on 127.0.0.1, every file under a temporary folder. A
 // 4-job sweep is submitted as a job array of shards; its merged tables must
 // equal those of a local `sweep run` of the same plan, and the resubmission
 // line of `sweep status` must rerun exactly the shard of a deleted run.
