@@ -218,9 +218,9 @@ FrameCacheWriter::~FrameCacheWriter() {
 void FrameCacheWriter::add(const CacheFrame& frame) {
   DRIFTLAB_DEMAND_MSG(!done_, "FrameCacheWriter::add after commit");
   Row r;
-  r.meta = frame;
-  r.meta.left = {};
-  r.meta.right = {};
+  r.meta.k = frame.k;  // the metadata only: the images go to files
+  r.meta.exposure_ms = frame.exposure_ms;
+  r.meta.blur_samples = frame.blur_samples;
   r.width = frame.left.width;
   r.height = frame.left.height;
   const std::size_t i = rows_.size();

@@ -373,8 +373,7 @@ void apply_sets(Sweep* sweep, const std::vector<std::string>& assignments) {
   for (const std::string& a : assignments) {
     const auto eq = a.find('=');
     if (eq == std::string::npos || eq == 0)
-      throw UserError(
-          fmt::format("--set {}: got no KEY.PATH before '=', expected KEY.PATH=VALUE", a));
+      throw UserError(fmt::format("--set {}: got '{}', expected KEY.PATH=VALUE", a, a));
     const std::string key = a.substr(0, eq);
     const std::string where = "--set " + a;
     // A key the file fixes takes the command line's value; another joins the fixed ones.
