@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <charconv>
+#include <cstdlib>
 #include <cstdint>
 #include <functional>
 #include <stdexcept>
@@ -59,6 +60,18 @@ inline CLI::Validator seed_check() {
         return "";
       },
       "SEED");
+}
+
+/// `--frame-cache DIR`, the option of every command that renders frames: it sets
+/// DRIFTLAB_FRAME_CACHE for the command and every job it starts (pipeline/frame_cache.hpp reads
+/// it), so that a flag and the environment are one rule.
+inline void add_frame_cache_option(CLI::App* cmd) {
+  cmd->add_option_function<std::string>(
+      "--frame-cache",
+      [](const std::string& dir) { ::setenv("DRIFTLAB_FRAME_CACHE", dir.c_str(), 1); },
+      "Keep the rendered frames in DIR and replay them when nothing that decides them changed "
+      "(default: $DRIFTLAB_FRAME_CACHE; none when unset; size: $DRIFTLAB_FRAME_CACHE_GIB, "
+      "default 20)");
 }
 
 /// Parses argv into `app` and runs `dispatch`, mapping a bad command line to kExitUsage (after

@@ -40,6 +40,7 @@ DatasetCommands::DatasetCommands(CLI::App& app) {
   export_->add_option("--set", sets_, "Override a key: KEY.PATH=VALUE (repeatable)");
   export_->add_option("--seed", seed_, "Override the scenario seed")->check(seed_check());
   export_->add_flag("--force", force_, "Replace an existing output folder");
+  add_frame_cache_option(export_);
 
   vo_ = app.add_subcommand(
       "vo", "Run the built-in VOs on a KITTI or EuRoC stereo dataset and evaluate them");
@@ -91,6 +92,7 @@ int DatasetCommands::export_dataset() {
   o.replace_existing = force_;
   o.progress = stderr;
   o.progress_tty = isatty(STDERR_FILENO) != 0;
+  o.frame_cache = pipeline::FrameCacheOptions::from_environment();
   const auto summary = pipeline::export_dataset(scenario, out_, o);
   std::cout << summary.brief() << "\n";
   std::cerr << fmt::format("driftlab export: wrote {} ({})\n", out_, format_);

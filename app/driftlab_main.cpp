@@ -75,6 +75,7 @@ int run_command(const std::string& file, const std::string& out_dir,
   options.only_motion = only_motion;
   options.progress = stderr;
   options.progress_tty = isatty(STDERR_FILENO) != 0;
+  options.frame_cache = driftlab::pipeline::FrameCacheOptions::from_environment();
   const auto summary = driftlab::pipeline::run_scenario(scenario, out_dir, options);
   std::cout << summary.brief() << "\n";
   std::cerr << fmt::format("driftlab run: wrote {}\n", out_dir);
@@ -243,6 +244,7 @@ struct RunVerb : Pinned {
     cmd->add_flag("--force", force, "Replace an existing output folder");
     cmd->add_flag("--only-motion", only_motion,
                   "Stop after the physics stage (body_groundtruth.csv, groundtruth.tum)");
+    driftlab::app::add_frame_cache_option(cmd);
   }
 
   std::optional<int> dispatch() const {

@@ -76,6 +76,7 @@ StudyCommands::StudyCommands(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   run_->add_flag("--force", force_, "Run finished jobs again too");
+  add_frame_cache_option(run_);
   run_->add_option("--job-timeout", job_timeout_s_,
                    "Stop a job still running after this many seconds and record it as "
                    "timed out (0: no limit)")
@@ -295,6 +296,7 @@ int StudyCommands::run_manifest() {
     pl::JobRunOptions o;
     o.force = force;
     o.progress = stderr;
+    o.frame_cache = driftlab::pipeline::FrameCacheOptions::from_environment();
     const pl::JobRunResult r = pl::run_manifest_job(m, job_, o);
     std::cout << r.brief() << "\n";
     return 0;

@@ -67,7 +67,7 @@ ExportSummary export_dataset(const Scenario& sc, const fs::path& out_dir,
   const std::vector<sim::SampleTime> stamps =
       sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
   FrameSource source(sc, scene, mission.frames, stamps, run_threads(sc.pipeline.threads), 4,
-                     writer->wants_depth());
+                     writer->wants_depth(), options.frame_cache);
   ExportSummary summary;
   double render_s = 0;
   Progress progress(options.progress, "export", mission.camera_gt.size(), options.progress_tty);

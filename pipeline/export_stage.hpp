@@ -9,6 +9,7 @@
 #include <string>
 
 #include "dataset/dataset.hpp"
+#include "pipeline/frame_cache.hpp"
 #include "pipeline/scenario.hpp"
 
 namespace driftlab::pipeline {
@@ -19,6 +20,7 @@ struct ExportOptions {
   bool replace_existing = false;
   std::FILE* progress = nullptr;  ///< progress of the frame loop; null: none
   bool progress_tty = false;
+  FrameCacheOptions frame_cache;  ///< where frames are kept and replayed (no folder: nowhere)
 };
 
 struct ExportSummary {

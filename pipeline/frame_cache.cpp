@@ -11,6 +11,8 @@
 #include <cerrno>
 #include <charconv>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -249,6 +251,21 @@ bool FrameCacheWriter::commit() {
 // ---------------------------------------------------------------------------
 // Cache
 
+FrameCacheOptions FrameCacheOptions::from_environment() {
+  FrameCacheOptions o;
+  if (const char* dir = std::getenv("DRIFTLAB_FRAME_CACHE")) o.dir = dir;
+  if (const char* gib = std::getenv("DRIFTLAB_FRAME_CACHE_GIB"); gib && *gib) {
+    double value = 0;
+    if (!parse_number(std::string(gib), &value) || !(value > 0) || value > 1e6)
+      throw UserError(fmt::format(
+          "environment variable DRIFTLAB_FRAME_CACHE_GIB: got '{}', expected the frame cache's "
+          "size in GiB, a number above 0 (e.g. 20)",
+          gib));
+    o.max_bytes = static_cast<std::uint64_t>(value * static_cast<double>(1ULL << 30));
+  }
+  return o;
+}
+
 FrameCache::FrameCache(fs::path dir, std::uint64_t max_bytes)
     : dir_(std::move(dir)), max_bytes_(max_bytes) {
   std::error_code ec;
@@ -316,6 +333,23 @@ std::unique_ptr<FrameCacheWriter> FrameCache::fill(const std::string& key) const
   std::unique_ptr<FrameCacheWriter> w(new FrameCacheWriter(temp, entry));
   write_bytes(temp / "key.txt", key);
   return w;
+}
+
+FrameCache::FillLock::~FillLock() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+std::unique_ptr<FrameCache::FillLock> FrameCache::lock_fill(const std::string& key) const {
+  // A lock file beside the entries (names starting with '.' are never entries), never removed:
+  // removing it could hand two processes two different files to lock.
+  const fs::path path = dir_ / (".lock-" + fnv1a64_hex(key));
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw UserError(fmt::format("frame cache {}: cannot open {}: {}", dir_.string(), path.string(),
+                                std::strerror(errno)));
+  while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
+  }
+  return std::make_unique<FillLock>(fd);
 }
 
 std::size_t FrameCache::evict() const {

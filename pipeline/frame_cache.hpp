@@ -26,6 +26,18 @@
 
 namespace driftlab::pipeline {
 
+/// Where a run keeps its frames: `driftlab run/export/sweep run --frame-cache DIR`, or the
+/// environment (DRIFTLAB_FRAME_CACHE, DRIFTLAB_FRAME_CACHE_GIB).
+struct FrameCacheOptions {
+  std::filesystem::path dir;                   ///< empty: no cache
+  std::uint64_t max_bytes = 20ULL << 30;       ///< evict() keeps the cache to this size
+
+  /// DRIFTLAB_FRAME_CACHE (the folder; unset or empty: no cache) and DRIFTLAB_FRAME_CACHE_GIB
+  /// (its size in GiB, default 20). Throws UserError naming the variable, its value and what
+  /// was expected when the size is not a positive number.
+  static FrameCacheOptions from_environment();
+};
+
 /// One frame as the cache keeps it (a CapturedFrame without its render time).
 struct CacheFrame {
   std::size_t k = 0;  ///< index into the run's frame times
@@ -94,6 +106,10 @@ class FrameCache {
   std::unique_ptr<FrameCacheReader> find(const std::string& key, std::string* warning) const;
   /// A writer of a new entry for `key`.
   std::unique_ptr<FrameCacheWriter> fill(const std::string& key) const;
+  /// Waits until no other process fills `key`, then holds that until the lock is destroyed:
+  /// runs that want the same frames at once render them once (the second finds the entry).
+  class FillLock;
+  std::unique_ptr<FillLock> lock_fill(const std::string& key) const;
   /// Removes least recently used entries, never one being read, until at most max_bytes
   /// remain, and the folders of fills whose process is gone. Returns the entries removed.
   std::size_t evict() const;
@@ -105,6 +121,17 @@ class FrameCache {
  private:
   std::filesystem::path dir_;
   std::uint64_t max_bytes_;
+};
+
+class FrameCache::FillLock {
+ public:
+  explicit FillLock(int fd) : fd_(fd) {}
+  ~FillLock();
+  FillLock(const FillLock&) = delete;
+  FillLock& operator=(const FillLock&) = delete;
+
+ private:
+  int fd_;
 };
 
 }  // namespace driftlab::pipeline

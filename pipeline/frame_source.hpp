@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "pipeline/camera_stage.hpp"
+#include "pipeline/frame_cache.hpp"
 #include "pipeline/scenario.hpp"
 #include "sim/render/scene_geometry.hpp"
 #include "sim/sensors/clock.hpp"
@@ -29,6 +30,16 @@ struct CapturedFrame {
   int blur_samples = 1;      ///< renders averaged for its motion blur (CameraStage::blur_samples)
 };
 
+/// What the frame cache did for a source (metrics.json "frame_cache").
+struct FrameCacheStatus {
+  /// "off" (no cache, or frames it cannot keep), "hit" (replayed), "filled" (rendered and
+  /// kept), "miss" (rendered, not kept: `note` says why).
+  std::string state = "off";
+  std::string entry;  ///< the entry's folder, when there is a cache
+  std::string note;   ///< why off or not kept; a broken entry removed (a warning)
+  bool warn = false;  ///< `note` is a warning of the run
+};
+
 /// What the renderer reports once it has run.
 struct RenderInfo {
   std::string context;  ///< GL version and renderer
@@ -40,10 +51,13 @@ class FrameSource {
   /// Renders `scene` at the camera poses of `truth` (one per frame time), skipping the frames
   /// `stamps` marks dropped. threads >= 2: on a thread of its own, at most `queue_frames`
   /// ahead of the consumer; 1: inside next(). `scene` and `truth` must outlive the source.
-  /// depth: each frame also carries the true depth of the left image (images.depth_left).
+  /// depth: each frame also carries the true depth of the left image (images.depth_left; the
+  /// frame cache keeps no depth, so such a source renders). `cache`: where frames are kept
+  /// (an empty folder: nowhere).
   FrameSource(const Scenario& sc, const sim::SceneGeometry& scene,
               const std::vector<FrameTruth>& truth, const std::vector<sim::SampleTime>& stamps,
-              int threads, std::size_t queue_frames = 4, bool depth = false);
+              int threads, std::size_t queue_frames = 4, bool depth = false,
+              const FrameCacheOptions& cache = {});
   ~FrameSource();
   FrameSource(const FrameSource&) = delete;
   FrameSource& operator=(const FrameSource&) = delete;
@@ -52,6 +66,8 @@ class FrameSource {
   std::optional<CapturedFrame> next();
   /// Valid once next() has returned the first frame (or nothing).
   const RenderInfo& info() const;
+  /// Final once next() has returned nothing.
+  FrameCacheStatus cache_status() const;
 
  private:
   struct Impl;

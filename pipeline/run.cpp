@@ -428,7 +428,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   // their own when the run has more than one.
   const int threads = run_threads(sc.pipeline.threads);
   ExternalVoStage external(sc, dir, final_dir);  // exports of the frames for the external VOs
-  FrameSource source(sc, scene, mission.frames, stamps, threads, 4, external.wants_depth());
+  FrameSource source(sc, scene, mission.frames, stamps, threads, 4, external.wants_depth(),
+                     options.frame_cache);
   (*metrics)["timing"]["threads"] = threads;
 
   // Stages: VO and fusion. VO sees images and the rig only; the pipeline
@@ -463,6 +464,12 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   (*metrics)["timing"]["render_pairs_per_s"] =
       render_s > 0 ? static_cast<double>(camera_gt.size() - dropped) / render_s : 0.0;
   (*metrics)["camera"] = camera_metrics(sc, camera_gt.size(), dropped);
+  const FrameCacheStatus cache = source.cache_status();
+  (*metrics)["frame_cache"] = {{"state", cache.state}, {"entry", cache.entry}, {"note", cache.note}};
+  if (cache.warn) {
+    warnings.push_back(cache.note);
+    if (options.progress) fmt::print(options.progress, "warning: {}\n", cache.note);
+  }
   (*metrics)["warnings"] = warnings;
   (*metrics)["render"] = {{"context", source.info().context},
                           {"assets", scenes::shipped_asset_dir()},

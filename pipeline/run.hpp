@@ -15,6 +15,7 @@
 #include "core/trajectory_io.hpp"
 #include "dataset/dataset.hpp"
 #include "pipeline/camera_stage.hpp"
+#include "pipeline/frame_cache.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/sensor_stage.hpp"
 #include "sim/render/scene_geometry.hpp"
@@ -27,6 +28,7 @@ struct RunOptions {
   bool only_motion = false;       // stop after the physics stage
   std::FILE* progress = nullptr;  // progress of the frame loop (e.g. stderr); null: none
   bool progress_tty = false;      // redraw a bar in place (a terminal) instead of plain lines
+  FrameCacheOptions frame_cache;  // where frames are kept and replayed (no folder: nowhere)
 };
 
 struct RunSummary {

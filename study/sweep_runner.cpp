@@ -224,6 +224,7 @@ JobRunResult run_manifest_job(const SweepManifest& m, const std::string& id,
     RunOptions ro;
     ro.replace_existing = true;  // out.path() exists, empty
     ro.progress = options.progress;
+    ro.frame_cache = options.frame_cache;
     result.run = run_scenario(sc, out.path(), ro);
     nlohmann::ordered_json marker;
     marker["id"] = job.id;

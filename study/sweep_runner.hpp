@@ -19,6 +19,7 @@ namespace driftlab::study {
 struct JobRunOptions {
   bool force = false;             // run again even when done
   std::FILE* progress = nullptr;  // the run's frame-loop progress (plain lines); null: none
+  pipeline::FrameCacheOptions frame_cache;  // where the run keeps and finds its frames
 };
 
 struct JobRunResult {

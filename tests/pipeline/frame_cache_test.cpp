@@ -1,7 +1,8 @@
 // The frame cache's store: what goes in comes out byte for byte; an entry is found only under
 // its own key text; a corrupt, truncated, half-written or foreign entry is detected, removed
 // and never served; two fills of one key both finish; eviction drops the least recently used
-// entries first and never one being read.
+// entries first and never one being read. The key (frame_cache_key) changes with everything
+// that decides a frame's bytes and with nothing else.
 #include "pipeline/frame_cache.hpp"
 
 #include <gtest/gtest.h>
@@ -11,11 +12,13 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "core/error.hpp"
+#include "pipeline/frame_cache_key.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace driftlab::pipeline {
@@ -207,6 +210,78 @@ TEST(FrameCache, EvictionDropsTheLeastRecentlyUsedButNeverOneInUse) {
   EXPECT_TRUE(fs::exists(cache.entry_dir("a")));
   EXPECT_FALSE(fs::exists(cache.entry_dir("c")));
   expect_same(reading_a->frame(0), three_frames(1)[0]);
+}
+
+// ---------------------------------------------------------------------------
+// The key
+
+// What a run hands frame_cache_key(): a scenario, a small scene, frame truths and stamps.
+struct KeyInputs {
+  KeyInputs() : sc(load_scenario(fs::path(DRIFTLAB_SOURCE_DIR) / "scenarios/river_crossing.yaml")) {
+    sim::Mesh m;
+    m.name = "quad";
+    m.vertices = {{0, 0, 0, 0, 0, -1, 0, 0}, {1, 0, 0, 0, 0, -1, 1, 0}, {0, 1, 0, 0, 0, -1, 0, 1}};
+    m.indices = {0, 1, 2};
+    m.material.texture = 0;
+    scene.meshes.push_back(m);
+    scene.textures.push_back({"bark", 2, 2, {10, 20, 30, 40}});
+    for (int k = 0; k < 3; ++k) {
+      FrameTruth f;
+      f.t_s = k / 13.0;
+      f.T_W_B = SE3(Quat::Identity(), Vec3(0.1 * k, 0, 0));
+      truth.push_back(f);
+      stamps.push_back({k * 76'923'077LL, k * 76'923'077LL, false});
+    }
+  }
+  std::string key() const { return frame_cache_key(renderer_identity(gl), sc, scene, truth, stamps); }
+  Scenario sc;
+  sim::SceneGeometry scene;
+  std::vector<FrameTruth> truth;
+  std::vector<sim::SampleTime> stamps;
+  std::string gl = "OpenGL 4.5 (Core Profile) Mesa 22.3.6 / llvmpipe (LLVM 15.0.6, 256 bits)";
+};
+
+TEST(FrameCacheKey, NamesEverythingThatDecidesTheFrames) {
+  const std::string base = KeyInputs().key();
+  EXPECT_EQ(KeyInputs().key(), base);
+  EXPECT_NE(base.find(renderer_code_identity()), std::string::npos);
+  const std::vector<std::pair<std::string, std::function<void(KeyInputs&)>>> changes = {
+      {"the GL driver", [](KeyInputs& k) { k.gl = "OpenGL 4.5 (Core Profile) Mesa 23.0.0"; }},
+      {"the seed", [](KeyInputs& k) { k.sc.seed += 1; }},
+      {"a render option", [](KeyInputs& k) { k.sc.render.reflections = false; }},
+      {"a camera option", [](KeyInputs& k) { k.sc.sensors.camera.vignetting_strength += 0.01; }},
+      {"the wind", [](KeyInputs& k) { k.sc.water.wind.speed_mps += 0.5; }},
+      {"the frames asked for", [](KeyInputs& k) { k.sc.pipeline.max_frames = 7; }},
+      {"a texture pixel", [](KeyInputs& k) { k.scene.textures[0].pixels[3] ^= 1; }},
+      {"a vertex", [](KeyInputs& k) { k.scene.meshes[0].vertices[1].x = 1.0001f; }},
+      {"the lighting", [](KeyInputs& k) { k.scene.lighting.sun = true; }},
+      {"a pose by 1e-12 m",
+       [](KeyInputs& k) { k.truth[1].T_W_B = SE3(Quat::Identity(), Vec3(0.1 + 1e-12, 0, 0)); }},
+      {"a dropped frame", [](KeyInputs& k) { k.stamps[2].dropped = true; }},
+      {"a stamp", [](KeyInputs& k) { k.stamps[2].t_stamp_ns += 1; }},
+  };
+  for (const auto& [what, change] : changes) {
+    KeyInputs k;
+    change(k);
+    EXPECT_NE(k.key(), base) << what;
+  }
+}
+
+TEST(FrameCacheKey, LeavesOutWhatOnlyTheVosFiltersAndEvaluationSee) {
+  const std::string base = KeyInputs().key();
+  const std::vector<std::pair<std::string, std::function<void(KeyInputs&)>>> changes = {
+      {"the VOs", [](KeyInputs& k) { k.sc.pipeline.vo = {"dense"}; }},
+      {"a VO option", [](KeyInputs& k) { k.sc.pipeline.sparse.ransac_iterations = 8; }},
+      {"the filters", [](KeyInputs& k) { k.sc.pipeline.fusion = {}; }},
+      {"the threads", [](KeyInputs& k) { k.sc.pipeline.threads = 1; }},
+      {"the evaluation", [](KeyInputs& k) { k.sc.eval.section_length_m = 3; }},
+      {"the name", [](KeyInputs& k) { k.sc.name = "another"; }},
+  };
+  for (const auto& [what, change] : changes) {
+    KeyInputs k;
+    change(k);
+    EXPECT_EQ(k.key(), base) << what;
+  }
 }
 
 }  // namespace

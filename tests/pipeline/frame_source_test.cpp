@@ -1,16 +1,22 @@
 // The frame source: the render thread delivers exactly the frames the serial loop renders, in
 // order, skipping dropped ones; a consumer that stops early does not hang it; its errors come
-// out of next() as the serial loop's would.
+// out of next() as the serial loop's would. With a frame cache: replayed frames are the
+// rendered ones byte for byte, a broken entry is rendered again with a warning, two sources
+// wanting the same frames at once render them once, and frames with depth are not cached.
 #include "pipeline/frame_source.hpp"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/rotation.hpp"
 #include "scenes/build_scene.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::pipeline {
 namespace {
@@ -99,6 +105,110 @@ TEST(FrameSource, ZeroThreadsMeansEveryCore) {
   EXPECT_GE(run_threads(0), 1);
   EXPECT_EQ(run_threads(1), 1);
   EXPECT_EQ(run_threads(3), 3);
+}
+
+// ---------------------------------------------------------------------------
+// With a frame cache (issue 43)
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() /
+                     ("driftlab_frame_source_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  return d;
+}
+
+void expect_same_frames(const std::vector<CapturedFrame>& a, const std::vector<CapturedFrame>& b,
+                        const std::string& what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].k, b[i].k) << what << " " << i;
+    EXPECT_EQ(a[i].exposure_ms, b[i].exposure_ms) << what << " " << i;
+    EXPECT_EQ(a[i].blur_samples, b[i].blur_samples) << what << " " << i;
+    EXPECT_TRUE(a[i].images.left.pixels == b[i].images.left.pixels) << what << " " << i;
+    EXPECT_TRUE(a[i].images.right.pixels == b[i].images.right.pixels) << what << " " << i;
+  }
+}
+
+TEST(FrameSourceCache, ASecondSourceReplaysTheFirstsFramesByteForByte) {
+  const RiverLook s;
+  FrameSource plain(s.sc, s.scene, s.truth, s.stamps, 1);
+  const auto rendered = all_frames(plain);
+  EXPECT_EQ(plain.cache_status().state, "off");
+  for (const int threads : {1, 2}) {
+    FrameCacheOptions cache;
+    cache.dir = fresh_dir("replay");
+    FrameSource first(s.sc, s.scene, s.truth, s.stamps, threads, 4, false, cache);
+    expect_same_frames(rendered, all_frames(first), "filling");
+    EXPECT_EQ(first.cache_status().state, "filled");
+    FrameSource second(s.sc, s.scene, s.truth, s.stamps, threads, 4, false, cache);
+    expect_same_frames(rendered, all_frames(second), "replayed");
+    EXPECT_EQ(second.cache_status().state, "hit");
+    EXPECT_EQ(second.cache_status().entry, first.cache_status().entry);
+    EXPECT_EQ(second.info().context, plain.info().context);
+    EXPECT_EQ(second.info().triangles, plain.info().triangles);
+    fs::remove_all(cache.dir);
+  }
+}
+
+TEST(FrameSourceCache, ABrokenEntryIsRenderedAgainWithAWarning) {
+  const RiverLook s;
+  FrameCacheOptions cache;
+  cache.dir = fresh_dir("broken");
+  FrameSource first(s.sc, s.scene, s.truth, s.stamps, 1, 4, false, cache);
+  const auto rendered = all_frames(first);
+  const fs::path png = fs::path(first.cache_status().entry) / "000002_r.png";
+  std::string bytes = test::slurp(png);
+  bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 0x10);
+  std::ofstream(png, std::ios::binary) << bytes;
+  FrameSource second(s.sc, s.scene, s.truth, s.stamps, 2, 4, false, cache);
+  expect_same_frames(rendered, all_frames(second), "after the damage");
+  const FrameCacheStatus st = second.cache_status();
+  EXPECT_EQ(st.state, "filled");
+  EXPECT_TRUE(st.warn);
+  EXPECT_NE(st.note.find("000002_r.png does not hold the bytes the index names"),
+            std::string::npos)
+      << st.note;
+  FrameSource third(s.sc, s.scene, s.truth, s.stamps, 1, 4, false, cache);
+  expect_same_frames(rendered, all_frames(third), "refilled");
+  EXPECT_EQ(third.cache_status().state, "hit");
+  fs::remove_all(cache.dir);
+}
+
+TEST(FrameSourceCache, SourcesWantingTheSameFramesAtOnceRenderThemOnce) {
+  const RiverLook s;
+  FrameCacheOptions cache;
+  cache.dir = fresh_dir("together");
+  std::vector<CapturedFrame> frames[2];
+  FrameCacheStatus status[2];
+  auto take = [&](int i) {
+    FrameSource source(s.sc, s.scene, s.truth, s.stamps, 1, 4, false, cache);
+    frames[i] = all_frames(source);
+    status[i] = source.cache_status();
+  };
+  std::thread a(take, 0), b(take, 1);
+  a.join();
+  b.join();
+  std::multiset<std::string> states{status[0].state, status[1].state};
+  EXPECT_EQ(states, (std::multiset<std::string>{"filled", "hit"}));
+  expect_same_frames(frames[0], frames[1], "side by side");
+  std::size_t entries = 0;
+  for (const auto& e : fs::directory_iterator(cache.dir))
+    entries += e.path().filename().string().front() != '.' ? 1 : 0;
+  EXPECT_EQ(entries, 1u);
+  fs::remove_all(cache.dir);
+}
+
+TEST(FrameSourceCache, FramesWithDepthAreRenderedNotCached) {
+  const RiverLook s;
+  FrameCacheOptions cache;
+  cache.dir = fresh_dir("depth");
+  FrameSource source(s.sc, s.scene, s.truth, s.stamps, 1, 4, /*depth=*/true, cache);
+  const auto frames = all_frames(source);
+  ASSERT_FALSE(frames.empty());
+  EXPECT_FALSE(frames[0].images.depth_left.depth_m.empty());
+  EXPECT_EQ(source.cache_status().state, "off");
+  EXPECT_NE(source.cache_status().note.find("no ground-truth depth"), std::string::npos);
+  fs::remove_all(cache.dir);
 }
 
 }  // namespace

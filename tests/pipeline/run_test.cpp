@@ -120,34 +120,50 @@ std::string frames_without_timing(const fs::path& dir) {
   return out;
 }
 
-TEST(Run, SameBytesWhateverTheThreadCount) {
+TEST(Run, SameBytesWhateverTheThreadCountAndFromTheFrameCache) {
   // Rendering on a thread of its own and the two VOs side by side (threads: 2) or all in turn
   // (threads: 1), with dropped frames and a keyframe VO: the same estimates, tables and
-  // per-frame rows.
-  const fs::path a = temp_dir("threads1"), b = temp_dir("threads2");
+  // per-frame rows. Issue 43: the same again when the frames are rendered into the frame cache
+  // (b) and replayed from it (c, with another thread count, which the key leaves out).
+  const fs::path a = temp_dir("threads1"), b = temp_dir("threads2"), c = temp_dir("cached"),
+                 cache = temp_dir("frame_cache");
   Scenario sc = short_crossing(40);
   sc.pipeline.vo = {"sparse", "sparse_kf"};
   sc.sensors.camera.clock.drop_probability = 0.1;
   sc.pipeline.threads = 1;
   run_scenario(sc, a, {});
   sc.pipeline.threads = 2;
-  run_scenario(sc, b, {});
-  for (const char* f :
-       {"estimates/sparse.tum", "estimates/sparse_ca.tum", "estimates/sparse_kf.tum",
-        "estimates/sparse_kf_ca.tum", "sections.csv", "plots/data/sparse.dat"})
-    EXPECT_EQ(slurp(a / f), slurp(b / f)) << f;
-  EXPECT_EQ(frames_without_timing(a), frames_without_timing(b));
+  RunOptions cached;
+  cached.frame_cache.dir = cache;
+  run_scenario(sc, b, cached);
+  sc.pipeline.threads = 1;
+  run_scenario(sc, c, cached);
   auto metrics = [](const fs::path& d) {
     auto j = nlohmann::json::parse(slurp(d / "metrics.json"));
     j.erase("timing");
     return j;
   };
-  const auto ma = metrics(a);
-  EXPECT_EQ(ma.dump(), metrics(b).dump());
+  const auto ma = metrics(a), mb = metrics(b), mc = metrics(c);
+  EXPECT_EQ(ma["frame_cache"]["state"], "off");
+  EXPECT_EQ(mb["frame_cache"]["state"], "filled");
+  EXPECT_EQ(mc["frame_cache"]["state"], "hit");
+  EXPECT_EQ(mb["frame_cache"]["entry"], mc["frame_cache"]["entry"]);
+  for (const fs::path& d : {b, c}) {
+    for (const char* f :
+         {"estimates/sparse.tum", "estimates/sparse_ca.tum", "estimates/sparse_kf.tum",
+          "estimates/sparse_kf_ca.tum", "sections.csv", "plots/data/sparse.dat",
+          "plots/sparse_matches.png"})
+      EXPECT_EQ(slurp(a / f), slurp(d / f)) << d << " " << f;
+    EXPECT_EQ(frames_without_timing(a), frames_without_timing(d)) << d;
+    auto m = metrics(d);
+    m.erase("frame_cache");
+    auto m0 = ma;
+    m0.erase("frame_cache");
+    EXPECT_EQ(m0.dump(), m.dump()) << d;
+  }
   EXPECT_GT(ma["camera"]["frames_dropped"].get<int>(), 0);
   EXPECT_NE(frames_without_timing(a).find("sparse_kf_ref_frames"), std::string::npos);
-  fs::remove_all(a);
-  fs::remove_all(b);
+  for (const fs::path& d : {a, b, c, cache}) fs::remove_all(d);
 }
 
 // The rows of a sections.csv whose algorithm column is `algo`.
@@ -199,7 +215,7 @@ TEST(Run, SensorsSampleAtTheirRatesFromTheSameGroundTruth) {
   sc.sensors.camera.rate_hz = 13;  // 27 frames: 2 s
   sc.sensors.imu.preset = sim::ImuPreset::kIdeal;
   sc.sensors.imu.apply_preset(sim::ImuPreset::kIdeal);
-  run_scenario(sc, out, {.only_motion = true});
+  run_scenario(sc, out, {.only_motion = true, .frame_cache = {}});
   auto rows = [&](const char* f) {
     const std::string s = slurp(out / f);
     return std::count(s.begin(), s.end(), '\n') - 1;  // without the header
@@ -228,7 +244,7 @@ TEST(Run, SensorsSampleAtTheirRatesFromTheSameGroundTruth) {
 TEST(Run, WholeDischargeMeasurementMission) {
   const fs::path out = temp_dir("mission");
   Scenario sc = load_scenario(kSource / "scenarios/river_crossing.yaml");
-  RunSummary sum = run_scenario(sc, out, {.only_motion = true});
+  RunSummary sum = run_scenario(sc, out, {.only_motion = true, .frame_cache = {}});
   EXPECT_TRUE(sum.motion.mission_completed);
   // Over 300 s of mission (54 m at 0.17 m/s plus the turns), a frame per camera period.
   EXPECT_GT(static_cast<double>(sum.frames), sc.sensors.camera.rate_hz * 300);
@@ -239,7 +255,7 @@ TEST(Run, WholeDischargeMeasurementMission) {
   // In still water: the river paper's discharge measurement, 4 x 13.5 = 54 m
   // at a mean 0.17 m/s.
   sc.water.current.speed_mps = 0;
-  sum = run_scenario(sc, out, {.replace_existing = true, .only_motion = true});
+  sum = run_scenario(sc, out, {.replace_existing = true, .only_motion = true, .frame_cache = {}});
   EXPECT_NEAR(sum.motion.distance_m, 54.0, 2.0);  // + overshoot at the ends of the legs
   fs::remove_all(out);
 }

@@ -1,0 +1,144 @@
+#include "pipeline/frame_cache_key.hpp"
+
+#include <fmt/format.h>
+
+#include <cstring>
+#include <opencv2/core/utility.hpp>
+#include <string_view>
+
+#include "core/hash.hpp"
+#include "core/yaml_io.hpp"
+
+namespace driftlab::pipeline {
+namespace {
+
+// FNV-1a 64 over values fed one by one (their bytes as they lie in memory: doubles and floats
+// hash bit for bit, so -0 and 0 differ, as they may in a frame).
+class Fingerprint {
+ public:
+  template <class T>
+  void add(const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    h_ = fnv1a64(std::string_view(reinterpret_cast<const char*>(&value), sizeof(T)), h_);
+  }
+  template <class T>
+  void add_all(const std::vector<T>& values) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    add(values.size());
+    h_ = fnv1a64(std::string_view(reinterpret_cast<const char*>(values.data()),
+                                  values.size() * sizeof(T)),
+                 h_);
+  }
+  void add(const std::string& text) {
+    add(text.size());
+    h_ = fnv1a64(text, h_);
+  }
+  std::string hex() const { return hex64(h_); }
+
+ private:
+  std::uint64_t h_ = fnv1a64("");
+};
+
+// The scenario's sections that decide the frames, in the order of Scenario::visit.
+struct FrameDecidingSections {
+  explicit FrameDecidingSections(const Scenario& sc)
+      : seed(sc.seed),
+        scene(sc.scene),
+        water(sc.water),
+        vessel(sc.vessel),
+        mission(sc.mission),
+        sensors(sc.sensors),
+        render(sc.render),
+        max_frames(sc.pipeline.max_frames) {}
+  std::uint64_t seed;
+  scenes::SceneOptions scene;
+  sim::WaterOptions water;
+  sim::VesselOptions vessel;
+  sim::MissionOptions mission;
+  sim::SensorOptions sensors;
+  sim::RenderOptions render;
+  int max_frames;
+
+  template <class A>
+  void visit(A& a) {
+    a("seed", seed, "");
+    a("scene", scene, "");
+    a("water", water, "");
+    a("vessel", vessel, "");
+    a("mission", mission, "");
+    a("sensors", sensors, "");
+    a("render", render, "");
+    a("pipeline_max_frames", max_frames, "");
+  }
+};
+
+}  // namespace
+
+std::string renderer_identity(const std::string& gl_context) {
+  return fmt::format("code {}\nopencv {}\ngl {}\n", renderer_code_identity(),
+                     cv::getVersionString(), gl_context);
+}
+
+std::string scene_fingerprint(const sim::SceneGeometry& scene) {
+  static_assert(sizeof(sim::Vertex) == 8 * sizeof(float), "Vertex has padding: hash its fields");
+  Fingerprint f;
+  f.add(scene.meshes.size());
+  for (const sim::Mesh& m : scene.meshes) {
+    f.add(m.name);
+    f.add_all(m.vertices);
+    f.add_all(m.indices);
+    f.add(m.material.texture);
+    f.add(m.material.albedo);
+    f.add(m.material.specular);
+    f.add(m.material.double_sided);
+  }
+  f.add(scene.textures.size());
+  for (const sim::Texture& t : scene.textures) {
+    f.add(t.name);
+    f.add(t.width);
+    f.add(t.height);
+    f.add_all(t.pixels);
+  }
+  const sim::Lighting& l = scene.lighting;
+  for (const float v : {l.sun ? 1.f : 0.f, l.sun_direction_W.x(), l.sun_direction_W.y(),
+                        l.sun_direction_W.z(), l.ambient, l.diffuse, l.sky_brightness,
+                        l.fog_distance_m})
+    f.add(v);
+  const sim::WaterAppearance& w = scene.water;
+  for (const float v : {w.enabled ? 1.f : 0.f, w.extent_m, w.body_gray, w.turbidity,
+                        w.reflectivity})
+    f.add(v);
+  return f.hex();
+}
+
+std::string truth_fingerprint(const std::vector<FrameTruth>& truth,
+                              const std::vector<sim::SampleTime>& stamps) {
+  Fingerprint f;
+  f.add(truth.size());
+  for (const FrameTruth& t : truth) {
+    f.add(t.t_s);
+    const Quat& q = t.T_W_B.quaternion();
+    const Vec3& p = t.T_W_B.translation();
+    for (const double v : {q.w(), q.x(), q.y(), q.z(), p.x(), p.y(), p.z()}) f.add(v);
+    for (int i = 0; i < 6; ++i) f.add(t.twist_B[i]);
+  }
+  f.add(stamps.size());
+  for (const sim::SampleTime& s : stamps) {
+    f.add(s.t_true_ns);
+    f.add(s.t_stamp_ns);
+    f.add(s.dropped);
+  }
+  return f.hex();
+}
+
+std::string frame_cache_key(const std::string& identity, const Scenario& sc,
+                            const sim::SceneGeometry& scene, const std::vector<FrameTruth>& truth,
+                            const std::vector<sim::SampleTime>& stamps) {
+  return fmt::format(
+      "driftlab frame cache key, version 1\n{}scene_fnv1a64 {}\ntruth_fnv1a64 {}\n"
+      "frames {}\n{}",
+      identity, scene_fingerprint(scene), truth_fingerprint(truth, stamps), truth.size(),
+      yaml::to_yaml(FrameDecidingSections(sc), false));
+}
+
+}  // namespace driftlab::pipeline
