@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -21,6 +23,12 @@ namespace {
 std::string g(double v) { return fmt::format("{:.6g}", v); }
 
 }  // namespace
+
+double pairs_mean(const std::vector<PairValue>& pairs) {
+  double sum = 0;
+  for (const PairValue& p : pairs) sum += p.value;
+  return pairs.empty() ? 0.0 : sum / static_cast<double>(pairs.size());
+}
 
 double BaselineMetric::tolerance() const {
   return std::max(abs_tol, baseline ? rel_tol * std::abs(*baseline) : 0.0);
@@ -56,11 +64,21 @@ std::string baseline_json(const Baseline& b) {
     e["key"] = m.key;
     e["baseline"] = m.baseline ? nlohmann::ordered_json(*m.baseline) : nlohmann::ordered_json();
     e["direction"] = std::string(yaml::enum_name(m.direction));
-    e["abs_tol"] = m.abs_tol;
-    e["rel_tol"] = m.rel_tol;
+    if (m.pairs.empty()) {
+      e["abs_tol"] = m.abs_tol;
+      e["rel_tol"] = m.rel_tol;
+    } else {
+      e["min_effect"] = m.min_effect;
+      e["alpha"] = m.alpha;
+      e["pairs"] = nlohmann::ordered_json::array();
+      for (const PairValue& p : m.pairs) e["pairs"].push_back({{"id", p.id}, {"value", p.value}});
+    }
     j["metrics"].push_back(e);
   }
-  return j.dump(2) + "\n";
+  // One line per pair: a baseline of a few hundred pairs stays readable.
+  std::string text = j.dump(2);
+  static const std::regex pair_object(R"(\{\s+"id": ("[^"]*"),\s+"value": ([^\s}]+)\s+\})");
+  return std::regex_replace(text, pair_object, R"({"id": $1, "value": $2})") + "\n";
 }
 
 fs::path find_results_metrics(const fs::path& results) {
@@ -96,44 +114,49 @@ nlohmann::json read_results_metrics(const fs::path& file) {
   }
 }
 
-std::optional<double> metric_value(const nlohmann::json& doc, const std::string& key,
-                                   std::string* why) {
+const nlohmann::json* metric_node(const nlohmann::json& doc, const std::string& key,
+                                  std::string* why) {
   const nlohmann::json* node = &doc;
   if (!key.empty() && key[0] == '/') {
     try {
       const nlohmann::json::json_pointer ptr(key);
       if (!doc.contains(ptr)) {
         *why = "no such key";
-        return std::nullopt;
+        return nullptr;
       }
-      node = &doc.at(ptr);
+      return &doc.at(ptr);
     } catch (const nlohmann::json::exception& e) {
       *why = std::string("not a valid JSON pointer: ") + e.what();
-      return std::nullopt;
-    }
-  } else {
-    std::size_t start = 0;
-    std::string walked;
-    while (true) {
-      const auto dot = key.find('.', start);
-      const std::string part = key.substr(start, dot == std::string::npos ? dot : dot - start);
-      if (node->is_object() && node->contains(part)) {
-        node = &(*node)[part];
-      } else if (node->is_array() && !part.empty() &&
-                 std::all_of(part.begin(), part.end(),
-                             [](char ch) { return ch >= '0' && ch <= '9'; }) &&
-                 std::stoul(part) < node->size()) {
-        node = &(*node)[std::stoul(part)];
-      } else {
-        *why = walked.empty() ? fmt::format("no '{}' at the top level", part)
-                              : fmt::format("no '{}' under {}", part, walked);
-        return std::nullopt;
-      }
-      walked += (walked.empty() ? "" : ".") + part;
-      if (dot == std::string::npos) break;
-      start = dot + 1;
+      return nullptr;
     }
   }
+  std::size_t start = 0;
+  std::string walked;
+  while (true) {
+    const auto dot = key.find('.', start);
+    const std::string part = key.substr(start, dot == std::string::npos ? dot : dot - start);
+    if (node->is_object() && node->contains(part)) {
+      node = &(*node)[part];
+    } else if (node->is_array() && !part.empty() &&
+               std::all_of(part.begin(), part.end(),
+                           [](char ch) { return ch >= '0' && ch <= '9'; }) &&
+               std::stoul(part) < node->size()) {
+      node = &(*node)[std::stoul(part)];
+    } else {
+      *why = walked.empty() ? fmt::format("no '{}' at the top level", part)
+                            : fmt::format("no '{}' under {}", part, walked);
+      return nullptr;
+    }
+    walked += (walked.empty() ? "" : ".") + part;
+    if (dot == std::string::npos) return node;
+    start = dot + 1;
+  }
+}
+
+std::optional<double> metric_value(const nlohmann::json& doc, const std::string& key,
+                                   std::string* why) {
+  const nlohmann::json* node = metric_node(doc, key, why);
+  if (!node) return std::nullopt;
   if (node->is_null()) {
     *why = "null (not computed for these results)";
     return std::nullopt;
@@ -145,6 +168,74 @@ std::optional<double> metric_value(const nlohmann::json& doc, const std::string&
   return node->get<double>();
 }
 
+std::optional<std::vector<PairValue>> metric_pairs(const nlohmann::json& doc,
+                                                   const std::string& key, std::string* why) {
+  const nlohmann::json* node = metric_node(doc, key, why);
+  if (!node) return std::nullopt;
+  if (!node->is_object() || node->empty()) {
+    *why = fmt::format("not an object of paired values ({})", node->type_name());
+    return std::nullopt;
+  }
+  std::vector<PairValue> pairs;
+  for (const auto& [id, v] : node->items())
+    if (v.is_number() && std::isfinite(v.get<double>())) pairs.push_back({id, v.get<double>()});
+  return pairs;
+}
+
+namespace {
+
+// The verdict of a change `diff` (new - baseline) that is beyond the metric's bar in the bad
+// direction (`worse`) or in the good one (`better`), as the direction reads them.
+Verdict verdict_of(MetricDirection direction, bool up, bool down) {
+  switch (direction) {
+    case MetricDirection::kLower:
+      return up ? Verdict::kRegressed : down ? Verdict::kImproved : Verdict::kPass;
+    case MetricDirection::kHigher:
+      return down ? Verdict::kRegressed : up ? Verdict::kImproved : Verdict::kPass;
+    case MetricDirection::kBoth:
+      return up || down ? Verdict::kRegressed : Verdict::kPass;
+  }
+  return Verdict::kPass;
+}
+
+// A paired metric: the new values at its key, matched to the baseline's pairs by id.
+void check_paired(const nlohmann::json& results, MetricCheck* c) {
+  const BaselineMetric& m = c->metric;
+  const auto found = metric_pairs(results, m.key, &c->note);
+  if (!found) {
+    c->verdict = Verdict::kMissing;
+    return;
+  }
+  c->new_pairs = *found;
+  std::map<std::string, double> by_id;
+  for (const PairValue& p : *found) by_id[p.id] = p.value;
+  std::vector<double> a, b;
+  std::vector<std::string> missing;
+  for (const PairValue& p : m.pairs) {
+    const auto it = by_id.find(p.id);
+    if (it == by_id.end()) {
+      missing.push_back(p.id);
+      continue;
+    }
+    a.push_back(p.value);
+    b.push_back(it->second);
+  }
+  const PairedChange pc = paired_change(a, b);
+  c->paired = pc;
+  c->value = pc.mean_b;
+  if (!missing.empty()) {
+    c->verdict = Verdict::kMissing;
+    c->note = fmt::format("{} of {} pairs have no value in the results (first {})",
+                          missing.size(), m.pairs.size(), missing.front());
+    return;
+  }
+  const bool up = pc.test.p_greater < m.alpha && pc.rel > m.min_effect;
+  const bool down = pc.test.p_less < m.alpha && pc.rel < -m.min_effect;
+  c->verdict = verdict_of(m.direction, up, down);
+}
+
+}  // namespace
+
 GateResult check_baseline(const Baseline& baseline, const nlohmann::json& results,
                           const fs::path& results_file) {
   GateResult r;
@@ -153,8 +244,9 @@ GateResult check_baseline(const Baseline& baseline, const nlohmann::json& result
   for (const auto& m : baseline.metrics) {
     MetricCheck c;
     c.metric = m;
-    c.value = metric_value(results, m.key, &c.note);
-    if (!c.value) {
+    if (!m.pairs.empty()) {
+      check_paired(results, &c);
+    } else if (c.value = metric_value(results, m.key, &c.note); !c.value) {
       c.verdict = Verdict::kMissing;
     } else if (!m.baseline) {
       c.verdict = Verdict::kNoBaseline;
@@ -162,21 +254,7 @@ GateResult check_baseline(const Baseline& baseline, const nlohmann::json& result
     } else {
       const double diff = *c.value - *m.baseline;
       const double tol = m.tolerance();
-      switch (m.direction) {
-        case MetricDirection::kLower:
-          c.verdict = diff > tol    ? Verdict::kRegressed
-                      : diff < -tol ? Verdict::kImproved
-                                    : Verdict::kPass;
-          break;
-        case MetricDirection::kHigher:
-          c.verdict = diff < -tol  ? Verdict::kRegressed
-                      : diff > tol ? Verdict::kImproved
-                                   : Verdict::kPass;
-          break;
-        case MetricDirection::kBoth:
-          c.verdict = std::abs(diff) > tol ? Verdict::kRegressed : Verdict::kPass;
-          break;
-      }
+      c.verdict = verdict_of(m.direction, diff > tol, diff < -tol);
     }
     r.checks.push_back(std::move(c));
   }
@@ -191,6 +269,11 @@ std::size_t GateResult::failures() const {
 namespace {
 
 std::string change_text(const MetricCheck& c) {
+  if (c.paired) {
+    const PairedChange& p = *c.paired;
+    if (p.n == 0 || p.mean_a == 0) return "";
+    return fmt::format("{:+.1f}% [{:+.1f}, {:+.1f}]", 100 * p.rel, 100 * p.rel_lo, 100 * p.rel_hi);
+  }
   if (!c.value || !c.metric.baseline) return "";
   const double diff = *c.value - *c.metric.baseline;
   std::string s = fmt::format("{:+.3g}", diff);
@@ -199,10 +282,23 @@ std::string change_text(const MetricCheck& c) {
   return s;
 }
 
+// The bar a change must clear: the tolerance, or for a paired metric the smallest effect and
+// the test's level with the p-value found.
 std::string tolerance_text(const MetricCheck& c) {
-  const char* sign = c.metric.direction == MetricDirection::kLower    ? "+"
-                     : c.metric.direction == MetricDirection::kHigher ? "-"
-                                                                      : "±";
+  const MetricDirection d = c.metric.direction;
+  const char* sign = d == MetricDirection::kLower ? "+" : d == MetricDirection::kHigher ? "-" : "±";
+  if (!c.metric.pairs.empty()) {
+    std::string s = fmt::format("{}{:.0f}% at p<{:g}", sign, 100 * c.metric.min_effect,
+                                c.metric.alpha);
+    if (c.paired && c.paired->n > 0) {
+      const SignedRankTest& t = c.paired->test;
+      const double p = d == MetricDirection::kLower    ? t.p_greater
+                       : d == MetricDirection::kHigher ? t.p_less
+                                                       : std::min(t.p_greater, t.p_less);
+      s += fmt::format(" (p={:.2g}, {} pairs)", p, c.paired->n);
+    }
+    return s;
+  }
   return sign + g(c.metric.tolerance());
 }
 
@@ -214,7 +310,10 @@ std::string GateResult::table() const {
   for (const auto& c : checks) {
     std::string verdict(yaml::enum_name(c.verdict));
     if (c.verdict == Verdict::kMissing) verdict += ": " + c.note;
-    rows.push_back({c.metric.key, c.metric.baseline ? g(*c.metric.baseline) : "—",
+    rows.push_back({c.metric.key,
+                    c.paired                ? g(c.paired->mean_a)
+                    : c.metric.baseline     ? g(*c.metric.baseline)
+                                            : "—",
                     c.value ? g(*c.value) : "—", change_text(c), tolerance_text(c), verdict});
   }
   std::array<std::size_t, 6> width{};
@@ -279,10 +378,10 @@ std::string GateResult::junit_xml() const {
       message = c.note;
     } else {
       message = fmt::format(
-          "regressed: baseline {}, new {}, change {}, tolerance {} ({} is "
+          "regressed: baseline {}, new {}, change {}, {} {} ({} is "
           "better)",
-          g(*c.metric.baseline), g(*c.value), change_text(c), tolerance_text(c),
-          yaml::enum_name(c.metric.direction));
+          g(c.paired ? c.paired->mean_a : *c.metric.baseline), g(*c.value), change_text(c),
+          c.paired ? "bar" : "tolerance", tolerance_text(c), yaml::enum_name(c.metric.direction));
     }
     x += fmt::format(">\n      <failure type=\"{}\" message=\"{}\">{}</failure>\n    </testcase>\n",
                      markup_escape(std::string(yaml::enum_name(c.verdict))), markup_escape(message),
@@ -298,7 +397,12 @@ Baseline updated_baseline(const Baseline& baseline, const GateResult& result) {
   std::string missing;
   for (std::size_t i = 0; i < b.metrics.size(); ++i) {
     const MetricCheck& c = result.checks.at(i);
-    if (!c.value) {
+    if (!c.metric.pairs.empty() && !c.new_pairs.empty()) {  // pairs the results lack go too
+      b.metrics[i].pairs = c.new_pairs;
+      b.metrics[i].baseline = pairs_mean(c.new_pairs);
+      continue;
+    }
+    if (!c.value || !c.metric.pairs.empty()) {
       missing += fmt::format("\n{}: {}: {}", c.metric.where, c.metric.key, c.note);
       continue;
     }

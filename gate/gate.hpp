@@ -15,6 +15,14 @@
 // keys that hold dots. direction: lower (lower is better: an increase beyond the
 // tolerance is a regression), higher, or both (any change beyond it is).
 // The tolerance is max(abs_tol, rel_tol * |baseline|); both default to 0.
+//
+// Paired metrics (issue 43): where the results hold a metric per job or per section of a job
+// (a merged sweep's algorithms.NAME.pairs.METRIC, an object {"p0000-r00/3": value, ...}), the
+// entry keeps every pair's value ("pairs": [{"id": ..., "value": ...}]) and the gate compares
+// the new values with them pair by pair (gate/paired.hpp): a regression is a change in the bad
+// direction that a one-sided Wilcoxon signed-rank test finds at level `alpha` AND that moves
+// the mean by more than `min_effect` of the baseline's. A pair the new results lack is a
+// failure (MISSING): a VO that loses sections must not pass by losing its worst ones.
 #pragma once
 
 #include <array>
@@ -25,6 +33,7 @@
 #include <vector>
 
 #include "core/yaml_io.hpp"
+#include "gate/paired.hpp"
 
 namespace driftlab::gate {
 
@@ -35,6 +44,20 @@ constexpr auto enum_table(MetricDirection) {
                     std::pair{MetricDirection::kBoth, "both"}};
 }
 
+/// One job's (or section's) value of a paired metric.
+struct PairValue {
+  std::string id;  ///< "JOB" or "JOB/SECTION"
+  double value = 0;
+
+  template <class A>
+  void visit(A& a) {
+    a("id", id, "The pair's name: a sweep job (p0000-r00) or a job's section (p0000-r00/3)",
+      yaml::non_empty() & yaml::required("the pair's name, e.g. p0000-r00/3"));
+    a("value", value, "The baseline's value for it",
+      yaml::required("a finite number") & yaml::expecting("a finite number"));
+  }
+};
+
 /// One gated metric of a baseline file.
 struct BaselineMetric {
   std::string key;
@@ -42,6 +65,9 @@ struct BaselineMetric {
   MetricDirection direction = MetricDirection::kLower;
   double abs_tol = 0;
   double rel_tol = 0;
+  std::vector<PairValue> pairs;  // empty: compared by tolerance
+  double min_effect = 0.05;      // paired: the smallest relative change of the mean that counts
+  double alpha = 0.01;           // paired: the signed-rank test's level
   std::string where;      // FILE:LINE:COL of the entry
   std::string key_where;  // FILE:LINE:COL of its key
   double tolerance() const;
@@ -65,8 +91,20 @@ struct BaselineMetric {
       yaml::non_negative() & yaml::expecting("a number >= 0"));
     a("rel_tol", rel_tol, "Relative tolerance, a fraction of |baseline|",
       yaml::non_negative() & yaml::expecting("a number >= 0"));
+    a("pairs", pairs,
+      "Paired metrics: the baseline's value of every job or section; the gate then decides by "
+      "a paired test instead of the tolerances (docs/sweeps.md: the CI regression gate)");
+    a("min_effect", min_effect,
+      "Paired metrics: the smallest change of the mean, a fraction of the baseline's, that can "
+      "fail the gate",
+      yaml::non_negative() & yaml::expecting("a number >= 0"));
+    a("alpha", alpha, "Paired metrics: the level of the one-sided signed-rank test",
+      yaml::in_range(0.0, 0.5));
   }
 };
+
+/// The mean of the pairs' values (0 for none).
+double pairs_mean(const std::vector<PairValue>& pairs);
 
 /// A baseline file, read by the strict reader like scenarios and sweeps.
 struct Baseline {
@@ -105,7 +143,9 @@ constexpr auto enum_table(Verdict) {
 
 struct MetricCheck {
   BaselineMetric metric;
-  std::optional<double> value;  // the new value
+  std::optional<double> value;  // the new value (paired: the new mean over the pairs)
+  std::optional<PairedChange> paired;  // paired metrics: the comparison
+  std::vector<PairValue> new_pairs;    // paired metrics: the new value of every pair
   Verdict verdict = Verdict::kPass;
   std::string note;  // why MISSING
   bool failed() const {
@@ -134,6 +174,15 @@ std::filesystem::path find_results_metrics(const std::filesystem::path& results)
 
 /// The JSON of a metrics.json; UserError naming the file when it is not valid JSON.
 nlohmann::json read_results_metrics(const std::filesystem::path& file);
+
+/// The node at a dotted key path or JSON pointer; null with `why` when absent.
+const nlohmann::json* metric_node(const nlohmann::json& doc, const std::string& key,
+                                  std::string* why);
+
+/// The pairs at a key that holds an object {id: number}, each finite value a pair (a merged
+/// sweep's algorithms.NAME.pairs.METRIC); nullopt with `why` otherwise.
+std::optional<std::vector<PairValue>> metric_pairs(const nlohmann::json& doc,
+                                                   const std::string& key, std::string* why);
 
 /// The value at a dotted key path or JSON pointer; nullopt with `why` when
 /// absent, null or not a number.

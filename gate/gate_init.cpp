@@ -48,7 +48,14 @@ std::vector<std::string> default_gate_keys(const nlohmann::json& results) {
   const bool sweep = results.contains("sweep");
   for (const auto& [name, a] : results["algorithms"].items()) {
     const std::string at = "algorithms." + name;
-    if (sweep) {  // a merged sweep: the pooled run statistics
+    if (sweep && a.contains("pairs")) {  // a merged sweep with per-job values: compared in pairs
+      std::string why;
+      for (const char* m : {"p_m_per_m_sections", "ape_trans_rmse_m", "ape_rot_rmse_deg"})
+        if (const auto p = metric_pairs(results, at + ".pairs." + m, &why); p && !p->empty())
+          keys.push_back(at + ".pairs." + m);
+      continue;
+    }
+    if (sweep) {  // a merged sweep of an older driftlab: the pooled run statistics
       for (const char* m : {"ape_trans_rmse_m", "ape_rot_rmse_deg", "p_m_per_m_mean"})
         add_if_present(results, at + ".runs." + m + ".mean", &keys);
       continue;
@@ -74,6 +81,21 @@ Baseline baseline_from_results(const nlohmann::json& results, const std::vector<
   b.description = options.description;
   std::string missing;
   for (const auto& key : keys) {
+    std::string why;
+    if (const nlohmann::json* node = metric_node(results, key, &why); node && node->is_object()) {
+      const auto pairs = metric_pairs(results, key, &why);
+      if (!pairs || pairs->empty()) {
+        missing += (missing.empty() ? "" : ", ") + key;
+        continue;
+      }
+      BaselineMetric m;
+      m.key = key;
+      m.pairs = *pairs;
+      m.baseline = pairs_mean(m.pairs);
+      m.direction = MetricDirection::kLower;
+      b.metrics.push_back(m);
+      continue;
+    }
     const auto f = find(results, key);
     if (!f) {
       missing += (missing.empty() ? "" : ", ") + key;

@@ -18,6 +18,7 @@
 #include "core/file_io.hpp"
 #include "core/process.hpp"
 #include "core/yaml_io.hpp"
+#include "gate/paired.hpp"
 #include "eval/regression.hpp"
 #include "eval/stats.hpp"
 #include "pipeline/scenario.hpp"
@@ -493,6 +494,83 @@ Part pooled_regression(const Pool& pool, const std::vector<const PooledSection*>
   return p;
 }
 
+// Every job's value of the gate's paired metrics (gate/gate.hpp), by job id, and every
+// section's position error by JOB/INDEX: what a baseline and a change are compared on pair by
+// pair (issue 43). Non-finite values are left out.
+nlohmann::ordered_json per_pair_values(const Pool& pool, const std::string& algo,
+                                       const std::vector<const PooledSection*>& rows) {
+  nlohmann::ordered_json pairs;
+  auto& sections = pairs["p_m_per_m_sections"] = nlohmann::ordered_json::object();
+  for (const PooledSection* s : rows) {
+    double v = 0;
+    const auto it = s->cells.find("p_m_per_m");
+    const auto index = s->cells.find("index");
+    if (it != s->cells.end() && index != s->cells.end() && yaml::parse_double(it->second, &v) &&
+        std::isfinite(v))
+      sections[pool.runs[s->run].job->id + "/" + index->second] = v;
+  }
+  for (const auto& rm : run_metrics()) {
+    nlohmann::ordered_json by_job = nlohmann::ordered_json::object();
+    for (const auto& r : pool.runs)
+      if (const double v = run_metric_value(r.metrics, algo, rm); std::isfinite(v))
+        by_job[r.job->id] = v;
+    if (!by_job.empty()) pairs[rm.name] = std::move(by_job);
+  }
+  return pairs;
+}
+
+// A/B statistics of every two algorithms on the same jobs (issue 43): for each paired metric,
+// the mean of B - A over the pairs both have (sections by JOB/INDEX, run metrics by job) with
+// its 95 % interval and the two-sided Wilcoxon signed-rank p-value (gate/paired.hpp).
+Part paired_algorithms(const nlohmann::ordered_json& algorithms) {
+  Part p;
+  p.json = nlohmann::ordered_json::object();
+  std::vector<std::string> names;
+  for (const auto& [name, a] : algorithms.items())
+    if (a.contains("pairs")) names.push_back(name);
+  if (names.size() < 2) return p;
+  const auto shown = [](const std::string& metric) {
+    for (const char* m : {"p_m_per_m_sections", "ape_trans_rmse_m", "ape_rot_rmse_deg",
+                          "track_length_error_pct", "lost_fraction"})
+      if (metric == m) return true;
+    return false;
+  };
+  p.md =
+      "\n## Paired comparisons\n\nEach row compares B with A on the same jobs (and sections): "
+      "the mean of B - A over the pairs both have, relative to A's mean, with its 95% "
+      "interval, and the two-sided signed-rank p-value (every metric: metrics.json "
+      "`paired`).\n\n| B vs A | metric | pairs | A | B | "
+      "B - A | p |\n|---|---|---|---|---|---|---|\n";
+  for (std::size_t i = 0; i < names.size(); ++i)
+    for (std::size_t j = i + 1; j < names.size(); ++j) {
+      const std::string label = names[j] + " vs " + names[i];
+      for (const auto& [metric, a_values] : algorithms[names[i]]["pairs"].items()) {
+        const auto& b_values = algorithms[names[j]]["pairs"];
+        if (!b_values.contains(metric)) continue;
+        std::vector<double> a, b;
+        for (const auto& [id, v] : a_values.items())
+          if (b_values[metric].contains(id)) {
+            a.push_back(v.get<double>());
+            b.push_back(b_values[metric][id].get<double>());
+          }
+        if (a.empty()) continue;
+        const gate::PairedChange c = gate::paired_change(a, b);
+        const double p_two = std::min(1.0, 2 * std::min(c.test.p_greater, c.test.p_less));
+        p.json[label][metric] = {{"pairs", c.n},          {"mean_a", c.mean_a},
+                                 {"mean_b", c.mean_b},    {"diff", c.diff},
+                                 {"diff_ci95", {c.diff_lo, c.diff_hi}},
+                                 {"rel", c.rel},          {"rel_ci95", {c.rel_lo, c.rel_hi}},
+                                 {"p_signed_rank", p_two}};
+        if (!shown(metric)) continue;  // metrics.json has them all
+        p.md += fmt::format("| {} | {} | {} | {:.4g} | {:.4g} | {:+.1f}% [{:+.1f}, {:+.1f}] | "
+                            "{:.2g} |\n",
+                            label, metric, c.n, c.mean_a, c.mean_b, 100 * c.rel, 100 * c.rel_lo,
+                            100 * c.rel_hi, p_two);
+      }
+    }
+  return p;
+}
+
 // One algorithm: pooled Table 1, the pooled regression, run metrics and --regress fits.
 Part merge_algorithm(const Pool& pool, const std::string& algo, const MergeOptions& o,
                      const Covariates& covariates, const std::vector<RunRegression>& regressions,
@@ -512,6 +590,7 @@ Part merge_algorithm(const Pool& pool, const std::string& algo, const MergeOptio
     for (const auto& r : pool.runs) v.push_back(run_metric_value(r.metrics, algo, rm));
     p.json["runs"][rm.name] = stat_json(stat_of(v));
   }
+  p.json["pairs"] = per_pair_values(pool, algo, rows);
   if (!o.run_regressions.empty()) {
     p.json["run_regressions"] = nlohmann::ordered_json::object();
     run_regressions(regressions, pool.runs, algo, &p.json["run_regressions"], &p.md, warnings);
@@ -775,6 +854,9 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
     md += p.md;
     metrics["algorithms"][algo] = std::move(p.json);
   }
+  Part paired = paired_algorithms(metrics["algorithms"]);
+  metrics["paired"] = std::move(paired.json);
+  md += paired.md;
   const Points points = per_point(m, pool);
   metrics["points"] = points.json;
   md += points.md;

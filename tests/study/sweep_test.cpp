@@ -455,7 +455,7 @@ TEST(SweepFolder, ShardsPartitionTheJobs) {
 }
 
 TEST(SweepFiles, ShippedSweepsAndTheCiBaselineAreValid) {
-  std::vector<fs::path> files = {kSource / "examples/ci/mini_sweep.yaml"};
+  std::vector<fs::path> files = {kSource / "examples/ci/gate_sweep.yaml"};
   for (const auto& e : fs::directory_iterator(kSource / "scenarios/sweeps"))
     if (e.path().extension() == ".yaml") files.push_back(e.path());
   EXPECT_GE(files.size(), 4u);  // yaw_variability, feature_depth, wave_amplitude, the CI one

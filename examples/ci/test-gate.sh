@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# The gate's own test (issue 43): run-gate.sh must fail (exit 5, naming the metrics that
+# regressed) on changes that make the sparse VO worse, and pass changes that do not. The gate
+# judges metrics, never settings: each change reaches it only through the VO's results.
+#   pipeline.sparse.lk_refinement=false        no sub-pixel refinement of the matches: must fail
+#   pipeline.sparse.ransac_iterations=8        too few RANSAC iterations: must fail
+#   pipeline.threads=1                         the same bytes, slower: must pass
+#   pipeline.sparse.descriptor_window_px=5     a smaller descriptor window: must pass
+# `scripts/test` runs it after run-gate.sh, so the frames come from the frame cache. The same
+# environment as run-gate.sh (DRIFTLAB, SWEEP, BASELINE, JOBS, DRIFTLAB_FRAME_CACHE).
+set -uo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+work=$(mktemp -d "${TMPDIR:-/tmp}/driftlab-gate-test.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+failures=0
+
+expect() {  # expect EXIT "KEY=VALUE"
+  local want=$1 set=$2 log="$work/$(echo "$2" | tr -c 'a-z0-9\n' '_').log"
+  GATE_SET="$set" OUT="$work/sweep" "$here/run-gate.sh" >"$log" 2>&1
+  local got=$?
+  rm -rf "$work/sweep"
+  local regressed
+  regressed=$(grep -c '^algorithms.* REGRESSED$' "$log")
+  if [ "$got" -ne "$want" ]; then
+    echo "test-gate: FAIL: GATE_SET=$set exited $got, expected $want; its output:" >&2
+    cat "$log" >&2
+    failures=$((failures + 1))
+  elif [ "$want" -eq 5 ] && ! grep -q '^algorithms\.sparse\.pairs\..* REGRESSED$' "$log"; then
+    echo "test-gate: FAIL: GATE_SET=$set exited 5 but named no sparse metric:" >&2
+    cat "$log" >&2
+    failures=$((failures + 1))
+  else
+    echo "test-gate: ok: GATE_SET=$set exits $got ($regressed metrics regressed)"
+    grep ' REGRESSED$' "$log" | sed 's/^/  /'
+  fi
+}
+
+expect 5 pipeline.sparse.lk_refinement=false
+expect 5 pipeline.sparse.ransac_iterations=8
+expect 0 pipeline.threads=1
+expect 0 pipeline.sparse.descriptor_window_px=5
+[ "$failures" -eq 0 ] || exit 1
+echo "test-gate: the gate failed both regressions and passed both harmless changes"
