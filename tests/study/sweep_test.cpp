@@ -878,5 +878,35 @@ TEST(SweepCli, BuiltInAndExternalVoSideBySideMergeIntoOneTable) {
   fs::remove_all(root);
 }
 
+TEST(SweepCli, JobsDifferingOnlyInVoOptionsRenderTheirFramesOnce) {
+  // Issue 43: two VO settings x two replicates, two jobs at once, one frame cache: each
+  // replicate's frames (its seed) are rendered by one job and replayed by the other, even when
+  // both start together.
+  const fs::path root = temp_dir("vo_only");
+  fs::create_directories(root);
+  std::ofstream(root / "sweep.yaml")
+      << "name: tiny_vo_only\nbase: " << (kSweeps / "tiny_base.yaml").string()
+      << "\nseed: 5\ndesign: grid\nreplicates: 2\nset:\n  pipeline.fusion: []\naxes:\n"
+         "  - key: pipeline.sparse.ransac_iterations\n    name: ransac\n    values: [200, 50]\n";
+  Result r =
+      run_cli({"sweep", "plan", (root / "sweep.yaml").string(), "--out", (root / "plan").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = run_cli({"sweep", "run", (root / "plan").string(), "-j", "2", "--frame-cache",
+               (root / "frames").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  std::map<std::string, std::multiset<std::string>> states;  // entry -> states of its jobs
+  for (const char* job : {"p0000-r00", "p0000-r01", "p0001-r00", "p0001-r01"}) {
+    const auto m = nlohmann::json::parse(slurp(root / "plan" / "runs" / job / "metrics.json"));
+    states[m["frame_cache"]["entry"].get<std::string>()].insert(
+        m["frame_cache"]["state"].get<std::string>());
+  }
+  ASSERT_EQ(states.size(), 2u);  // one frame sequence per replicate
+  for (const auto& [entry, s] : states) {
+    EXPECT_EQ(s, (std::multiset<std::string>{"filled", "hit"})) << entry;
+    EXPECT_TRUE(fs::exists(fs::path(entry) / "index.csv")) << entry;
+  }
+  fs::remove_all(root);
+}
+
 }  // namespace
 }  // namespace driftlab::study
