@@ -32,8 +32,8 @@ const std::vector<cv::Mat>& frames() {
       f.t_s = k / 8.2;
       f.T_W_B = SE3(quat_from_euler_zyx({0.0, 0.0, 0.2 * k}), Vec3(2.0 * k, 4, 0));
       truth.push_back(f);
-      stamps.push_back({static_cast<TimeNs>(k) * 121'951'220, static_cast<TimeNs>(k) * 121'951'220,
-                        false});
+      stamps.push_back(
+          {static_cast<TimeNs>(k) * 121'951'220, static_cast<TimeNs>(k) * 121'951'220, false});
     }
     pipeline::FrameSource source(sc, scene, truth, stamps, 1);
     std::vector<cv::Mat> out;

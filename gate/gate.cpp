@@ -225,8 +225,8 @@ void check_paired(const nlohmann::json& results, MetricCheck* c) {
   c->value = pc.mean_b;
   if (!missing.empty()) {
     c->verdict = Verdict::kMissing;
-    c->note = fmt::format("{} of {} pairs have no value in the results (first {})",
-                          missing.size(), m.pairs.size(), missing.front());
+    c->note = fmt::format("{} of {} pairs have no value in the results (first {})", missing.size(),
+                          m.pairs.size(), missing.front());
     return;
   }
   const bool up = pc.test.p_greater < m.alpha && pc.rel > m.min_effect;
@@ -288,8 +288,8 @@ std::string tolerance_text(const MetricCheck& c) {
   const MetricDirection d = c.metric.direction;
   const char* sign = d == MetricDirection::kLower ? "+" : d == MetricDirection::kHigher ? "-" : "±";
   if (!c.metric.pairs.empty()) {
-    std::string s = fmt::format("{}{:.0f}% at p<{:g}", sign, 100 * c.metric.min_effect,
-                                c.metric.alpha);
+    std::string s =
+        fmt::format("{}{:.0f}% at p<{:g}", sign, 100 * c.metric.min_effect, c.metric.alpha);
     if (c.paired && c.paired->n > 0) {
       const SignedRankTest& t = c.paired->test;
       const double p = d == MetricDirection::kLower    ? t.p_greater
@@ -311,9 +311,9 @@ std::string GateResult::table() const {
     std::string verdict(yaml::enum_name(c.verdict));
     if (c.verdict == Verdict::kMissing) verdict += ": " + c.note;
     rows.push_back({c.metric.key,
-                    c.paired                ? g(c.paired->mean_a)
-                    : c.metric.baseline     ? g(*c.metric.baseline)
-                                            : "—",
+                    c.paired            ? g(c.paired->mean_a)
+                    : c.metric.baseline ? g(*c.metric.baseline)
+                                        : "—",
                     c.value ? g(*c.value) : "—", change_text(c), tolerance_text(c), verdict});
   }
   std::array<std::size_t, 6> width{};

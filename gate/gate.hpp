@@ -68,8 +68,8 @@ struct BaselineMetric {
   std::vector<PairValue> pairs;  // empty: compared by tolerance
   double min_effect = 0.05;      // paired: the smallest relative change of the mean that counts
   double alpha = 0.01;           // paired: the signed-rank test's level
-  std::string where;      // FILE:LINE:COL of the entry
-  std::string key_where;  // FILE:LINE:COL of its key
+  std::string where;             // FILE:LINE:COL of the entry
+  std::string key_where;         // FILE:LINE:COL of its key
   double tolerance() const;
 
   template <class A>
@@ -143,7 +143,7 @@ constexpr auto enum_table(Verdict) {
 
 struct MetricCheck {
   BaselineMetric metric;
-  std::optional<double> value;  // the new value (paired: the new mean over the pairs)
+  std::optional<double> value;         // the new value (paired: the new mean over the pairs)
   std::optional<PairedChange> paired;  // paired metrics: the comparison
   std::vector<PairValue> new_pairs;    // paired metrics: the new value of every pair
   Verdict verdict = Verdict::kPass;

@@ -21,10 +21,10 @@ namespace driftlab::gate {
 constexpr std::size_t kExactWilcoxonPairs = 30;
 
 struct SignedRankTest {
-  std::size_t n = 0;       ///< non-zero differences
-  double w_plus = 0;       ///< sum of the ranks of the positive differences
-  double p_greater = 1;    ///< P(W+ >= w_plus) under H0: the differences lean positive
-  double p_less = 1;       ///< P(W+ <= w_plus) under H0: they lean negative
+  std::size_t n = 0;     ///< non-zero differences
+  double w_plus = 0;     ///< sum of the ranks of the positive differences
+  double p_greater = 1;  ///< P(W+ >= w_plus) under H0: the differences lean positive
+  double p_less = 1;     ///< P(W+ <= w_plus) under H0: they lean negative
   bool exact = false;
 };
 
@@ -32,10 +32,10 @@ struct SignedRankTest {
 SignedRankTest wilcoxon_signed_rank(const std::vector<double>& d);
 
 struct PairedChange {
-  std::size_t n = 0;                        ///< pairs
-  double mean_a = 0, mean_b = 0;            ///< means of the two sides over the pairs
+  std::size_t n = 0;                          ///< pairs
+  double mean_a = 0, mean_b = 0;              ///< means of the two sides over the pairs
   double diff = 0, diff_lo = 0, diff_hi = 0;  ///< mean of b - a and its 95 % interval
-  double rel = 0, rel_lo = 0, rel_hi = 0;   ///< the same over |mean_a| (0 when mean_a is 0)
+  double rel = 0, rel_lo = 0, rel_hi = 0;     ///< the same over |mean_a| (0 when mean_a is 0)
   SignedRankTest test;
 };
 

@@ -5,8 +5,9 @@
 //   key.txt     the key text itself, compared whole on every lookup (so two keys never share
 //               an entry, whatever their hashes);
 //   index.csv   one row per frame: k, exposure, blur samples, size, and the length and
-//               FNV-1a 64 of each PNG file; a last row `end,N` (a truncated index has none);
-//   NNNNNN_l.png, NNNNNN_r.png  the 8-bit rectified images, lossless.
+//               FNV-1a 64 of each image file; a last row `end,N` (a truncated index has none);
+//   NNNNNN_l.zst, NNNNNN_r.zst  the 8-bit rectified images, row by row, compressed by zstd
+//               (lossless).
 // An entry is filled in a folder of its own and published by one rename, so that a reader
 // never sees half of one; two processes filling the same key both finish, and the first
 // rename wins. Every byte is checked before an entry is used (find) and again as each frame is
@@ -29,8 +30,8 @@ namespace driftlab::pipeline {
 /// Where a run keeps its frames: `driftlab run/export/sweep run --frame-cache DIR`, or the
 /// environment (DRIFTLAB_FRAME_CACHE, DRIFTLAB_FRAME_CACHE_GIB).
 struct FrameCacheOptions {
-  std::filesystem::path dir;                   ///< empty: no cache
-  std::uint64_t max_bytes = 20ULL << 30;       ///< evict() keeps the cache to this size
+  std::filesystem::path dir;              ///< empty: no cache
+  std::uint64_t max_bytes = 20ULL << 30;  ///< evict() keeps the cache to this size
 
   /// DRIFTLAB_FRAME_CACHE (the folder; unset or empty: no cache) and DRIFTLAB_FRAME_CACHE_GIB
   /// (its size in GiB, default 20). Throws UserError naming the variable, its value and what

@@ -25,9 +25,9 @@ class Fingerprint {
   void add_all(const std::vector<T>& values) {
     static_assert(std::is_trivially_copyable_v<T>);
     add(values.size());
-    h_ = fnv1a64(std::string_view(reinterpret_cast<const char*>(values.data()),
-                                  values.size() * sizeof(T)),
-                 h_);
+    h_ = fnv1a64(
+        std::string_view(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)),
+        h_);
   }
   void add(const std::string& text) {
     add(text.size());
@@ -100,13 +100,13 @@ std::string scene_fingerprint(const sim::SceneGeometry& scene) {
     f.add_all(t.pixels);
   }
   const sim::Lighting& l = scene.lighting;
-  for (const float v : {l.sun ? 1.f : 0.f, l.sun_direction_W.x(), l.sun_direction_W.y(),
-                        l.sun_direction_W.z(), l.ambient, l.diffuse, l.sky_brightness,
-                        l.fog_distance_m})
+  for (const float v :
+       {l.sun ? 1.f : 0.f, l.sun_direction_W.x(), l.sun_direction_W.y(), l.sun_direction_W.z(),
+        l.ambient, l.diffuse, l.sky_brightness, l.fog_distance_m})
     f.add(v);
   const sim::WaterAppearance& w = scene.water;
-  for (const float v : {w.enabled ? 1.f : 0.f, w.extent_m, w.body_gray, w.turbidity,
-                        w.reflectivity})
+  for (const float v :
+       {w.enabled ? 1.f : 0.f, w.extent_m, w.body_gray, w.turbidity, w.reflectivity})
     f.add(v);
   return f.hex();
 }

@@ -114,9 +114,10 @@ struct ReplayProducer : Producer {
     DRIFTLAB_DEMAND_MSG(i < reader->size(), "frame cache entry has fewer frames than its key");
     CacheFrame c = reader->frame(i++);
     if (c.k != next_k)
-      throw UserError(fmt::format("frame cache entry {}: frame {} is frame {} of the run, its "
-                                  "key says {}; remove the entry",
-                                  reader->dir().string(), i - 1, c.k, next_k));
+      throw UserError(
+          fmt::format("frame cache entry {}: frame {} is frame {} of the run, its "
+                      "key says {}; remove the entry",
+                      reader->dir().string(), i - 1, c.k, next_k));
     ++next_k;
     CapturedFrame f;
     f.k = c.k;
@@ -135,8 +136,7 @@ struct ReplayProducer : Producer {
 // Rendering, each frame also written into a new entry, published after the last one.
 struct FillProducer : Producer {
   FillProducer(std::unique_ptr<RenderProducer> r, const FrameCache& c,
-               std::unique_ptr<FrameCache::FillLock> l, const std::string& key,
-               FrameCacheStatus* s)
+               std::unique_ptr<FrameCache::FillLock> l, const std::string& key, FrameCacheStatus* s)
       : render(std::move(r)), cache(c), lock(std::move(l)), writer(c.fill(key)), status(s) {
     info = render->info;
   }

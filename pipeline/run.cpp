@@ -465,7 +465,8 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
       render_s > 0 ? static_cast<double>(camera_gt.size() - dropped) / render_s : 0.0;
   (*metrics)["camera"] = camera_metrics(sc, camera_gt.size(), dropped);
   const FrameCacheStatus cache = source.cache_status();
-  (*metrics)["frame_cache"] = {{"state", cache.state}, {"entry", cache.entry}, {"note", cache.note}};
+  (*metrics)["frame_cache"] = {
+      {"state", cache.state}, {"entry", cache.entry}, {"note", cache.note}};
   if (cache.warn) {
     warnings.push_back(cache.note);
     if (options.progress) fmt::print(options.progress, "warning: {}\n", cache.note);

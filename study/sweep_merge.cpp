@@ -18,9 +18,9 @@
 #include "core/file_io.hpp"
 #include "core/process.hpp"
 #include "core/yaml_io.hpp"
-#include "gate/paired.hpp"
 #include "eval/regression.hpp"
 #include "eval/stats.hpp"
+#include "gate/paired.hpp"
 #include "pipeline/scenario.hpp"
 #include "study/run_regressions.hpp"
 
@@ -556,16 +556,20 @@ Part paired_algorithms(const nlohmann::ordered_json& algorithms) {
         if (a.empty()) continue;
         const gate::PairedChange c = gate::paired_change(a, b);
         const double p_two = std::min(1.0, 2 * std::min(c.test.p_greater, c.test.p_less));
-        p.json[label][metric] = {{"pairs", c.n},          {"mean_a", c.mean_a},
-                                 {"mean_b", c.mean_b},    {"diff", c.diff},
+        p.json[label][metric] = {{"pairs", c.n},
+                                 {"mean_a", c.mean_a},
+                                 {"mean_b", c.mean_b},
+                                 {"diff", c.diff},
                                  {"diff_ci95", {c.diff_lo, c.diff_hi}},
-                                 {"rel", c.rel},          {"rel_ci95", {c.rel_lo, c.rel_hi}},
+                                 {"rel", c.rel},
+                                 {"rel_ci95", {c.rel_lo, c.rel_hi}},
                                  {"p_signed_rank", p_two}};
         if (!shown(metric)) continue;  // metrics.json has them all
-        p.md += fmt::format("| {} | {} | {} | {:.4g} | {:.4g} | {:+.1f}% [{:+.1f}, {:+.1f}] | "
-                            "{:.2g} |\n",
-                            label, metric, c.n, c.mean_a, c.mean_b, 100 * c.rel, 100 * c.rel_lo,
-                            100 * c.rel_hi, p_two);
+        p.md += fmt::format(
+            "| {} | {} | {} | {:.4g} | {:.4g} | {:+.1f}% [{:+.1f}, {:+.1f}] | "
+            "{:.2g} |\n",
+            label, metric, c.n, c.mean_a, c.mean_b, 100 * c.rel, 100 * c.rel_lo, 100 * c.rel_hi,
+            p_two);
       }
     }
   return p;

@@ -10,8 +10,8 @@
 
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <random>
 
 #include "core/atomic_file.hpp"
@@ -81,14 +81,16 @@ TEST(PairedChange, MeanDifferenceAndItsStudentInterval) {
 Baseline paired_baseline(std::size_t n) {
   BaselineMetric m;
   m.key = "algorithms.sparse.pairs.p_m_per_m_sections";
-  for (std::size_t i = 0; i < n; ++i) m.pairs.push_back({"p0000-r00/" + std::to_string(i), 1.0 + i});
+  for (std::size_t i = 0; i < n; ++i)
+    m.pairs.push_back({"p0000-r00/" + std::to_string(i), 1.0 + i});
   m.baseline = pairs_mean(m.pairs);
   Baseline b;
   b.metrics.push_back(m);
   return b;
 }
 
-nlohmann::json results_with(const Baseline& b, const std::function<double(std::size_t, double)>& f) {
+nlohmann::json results_with(const Baseline& b,
+                            const std::function<double(std::size_t, double)>& f) {
   nlohmann::json pairs = nlohmann::json::object();
   const auto& p = b.metrics[0].pairs;
   for (std::size_t i = 0; i < p.size(); ++i) pairs[p[i].id] = f(i, p[i].value);
@@ -113,7 +115,8 @@ TEST(PairedGate, DecidesByTheTestAndTheSmallestEffect) {
             Verdict::kPass);
   // A pair the results lack fails the metric, whatever the others do.
   const GateResult lost = check_baseline(
-      b, [&] {
+      b,
+      [&] {
         nlohmann::json r = results_with(b, [](std::size_t, double v) { return v; });
         r["algorithms"]["sparse"]["pairs"]["p_m_per_m_sections"].erase("p0000-r00/7");
         return r;

@@ -92,17 +92,17 @@ TEST(FrameCache, BrokenEntriesAreRefusedAndRemoved) {
   const std::vector<Case> cases = {
       {"flipped byte",
        [](const fs::path& d) {
-         std::fstream f(d / "000001_r.png", std::ios::binary | std::ios::in | std::ios::out);
+         std::fstream f(d / "000001_r.zst", std::ios::binary | std::ios::in | std::ios::out);
          f.seekg(100);
          const char c = static_cast<char>(f.get());
          f.seekp(100);
          f.put(static_cast<char>(c ^ 0x10));
        },
-       "000001_r.png does not hold the bytes the index names"},
-      {"truncated image", [&](const fs::path& d) { truncate(d / "000002_l.png", 50); },
-       "000002_l.png has 50 bytes"},
-      {"missing image", [](const fs::path& d) { fs::remove(d / "000000_l.png"); },
-       "000000_l.png is missing"},
+       "000001_r.zst does not hold the bytes the index names"},
+      {"truncated image", [&](const fs::path& d) { truncate(d / "000002_l.zst", 50); },
+       "000002_l.zst has 50 bytes"},
+      {"missing image", [](const fs::path& d) { fs::remove(d / "000000_l.zst"); },
+       "000000_l.zst is missing"},
       {"truncated index",
        [&](const fs::path& d) { truncate(d / "index.csv", fs::file_size(d / "index.csv") - 6); },
        "index.csv is truncated"},
@@ -129,9 +129,9 @@ TEST(FrameCache, AFrameChangedWhileInUseIsAnErrorNotServed) {
   std::string warning;
   const auto r = cache.find("k", &warning);
   ASSERT_NE(r, nullptr) << warning;
-  fs::resize_file(cache.entry_dir("k") / "000001_l.png", 10);
+  fs::resize_file(cache.entry_dir("k") / "000001_l.zst", 10);
   EXPECT_NO_THROW(r->frame(0));
-  EXPECT_NE(test::user_error_of([&] { r->frame(1); }).find("000001_l.png has 10 bytes"),
+  EXPECT_NE(test::user_error_of([&] { r->frame(1); }).find("000001_l.zst has 10 bytes"),
             std::string::npos);
 }
 
@@ -183,7 +183,7 @@ TEST(FrameCache, EvictionDropsTheLeastRecentlyUsedButNeverOneInUse) {
     for (const auto& e : fs::directory_iterator(probe.entry_dir("probe")))
       entry_bytes += e.file_size();
   }
-  // Room for two entries of this size (noise images: every entry's PNGs are the same size
+  // Room for two entries of this size (noise images: every entry's files are the same size
   // within a few bytes).
   const FrameCache cache(dir, entry_bytes * 2 + entry_bytes / 2);
   const auto used_at = [&](const std::string& key, int seconds_ago) {
@@ -233,7 +233,9 @@ struct KeyInputs {
       stamps.push_back({k * 76'923'077LL, k * 76'923'077LL, false});
     }
   }
-  std::string key() const { return frame_cache_key(renderer_identity(gl), sc, scene, truth, stamps); }
+  std::string key() const {
+    return frame_cache_key(renderer_identity(gl), sc, scene, truth, stamps);
+  }
   Scenario sc;
   sim::SceneGeometry scene;
   std::vector<FrameTruth> truth;

@@ -156,17 +156,16 @@ TEST(FrameSourceCache, ABrokenEntryIsRenderedAgainWithAWarning) {
   cache.dir = fresh_dir("broken");
   FrameSource first(s.sc, s.scene, s.truth, s.stamps, 1, 4, false, cache);
   const auto rendered = all_frames(first);
-  const fs::path png = fs::path(first.cache_status().entry) / "000002_r.png";
-  std::string bytes = test::slurp(png);
+  const fs::path image = fs::path(first.cache_status().entry) / "000002_r.zst";
+  std::string bytes = test::slurp(image);
   bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 0x10);
-  std::ofstream(png, std::ios::binary) << bytes;
+  std::ofstream(image, std::ios::binary) << bytes;
   FrameSource second(s.sc, s.scene, s.truth, s.stamps, 2, 4, false, cache);
   expect_same_frames(rendered, all_frames(second), "after the damage");
   const FrameCacheStatus st = second.cache_status();
   EXPECT_EQ(st.state, "filled");
   EXPECT_TRUE(st.warn);
-  EXPECT_NE(st.note.find("000002_r.png does not hold the bytes the index names"),
-            std::string::npos)
+  EXPECT_NE(st.note.find("000002_r.zst does not hold the bytes the index names"), std::string::npos)
       << st.note;
   FrameSource third(s.sc, s.scene, s.truth, s.stamps, 1, 4, false, cache);
   expect_same_frames(rendered, all_frames(third), "refilled");

@@ -149,10 +149,9 @@ TEST(Run, SameBytesWhateverTheThreadCountAndFromTheFrameCache) {
   EXPECT_EQ(mc["frame_cache"]["state"], "hit");
   EXPECT_EQ(mb["frame_cache"]["entry"], mc["frame_cache"]["entry"]);
   for (const fs::path& d : {b, c}) {
-    for (const char* f :
-         {"estimates/sparse.tum", "estimates/sparse_ca.tum", "estimates/sparse_kf.tum",
-          "estimates/sparse_kf_ca.tum", "sections.csv", "plots/data/sparse.dat",
-          "plots/sparse_matches.png"})
+    for (const char* f : {"estimates/sparse.tum", "estimates/sparse_ca.tum",
+                          "estimates/sparse_kf.tum", "estimates/sparse_kf_ca.tum", "sections.csv",
+                          "plots/data/sparse.dat", "plots/sparse_matches.png"})
       EXPECT_EQ(slurp(a / f), slurp(d / f)) << d << " " << f;
     EXPECT_EQ(frames_without_timing(a), frames_without_timing(d)) << d;
     auto m = metrics(d);
