@@ -6,7 +6,6 @@
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 
@@ -59,6 +58,9 @@ std::string baseline_json(const Baseline& b) {
   nlohmann::ordered_json j;
   if (!b.description.empty()) j["description"] = b.description;
   j["metrics"] = nlohmann::ordered_json::array();
+  // Each metric's pairs one per line (a baseline of a few hundred pairs stays readable): a
+  // placeholder in the indented text, replaced by the compact lines.
+  std::vector<std::string> pair_lines;
   for (const auto& m : b.metrics) {
     nlohmann::ordered_json e;
     e["key"] = m.key;
@@ -70,15 +72,21 @@ std::string baseline_json(const Baseline& b) {
     } else {
       e["min_effect"] = m.min_effect;
       e["alpha"] = m.alpha;
-      e["pairs"] = nlohmann::ordered_json::array();
-      for (const PairValue& p : m.pairs) e["pairs"].push_back({{"id", p.id}, {"value", p.value}});
+      std::string lines;
+      for (const PairValue& p : m.pairs)
+        lines += (lines.empty() ? "\n        " : ",\n        ") +
+                 nlohmann::ordered_json{{"id", p.id}, {"value", p.value}}.dump();
+      e["pairs"] = fmt::format("@pairs {}@", pair_lines.size());
+      pair_lines.push_back("[" + lines + "\n      ]");
     }
     j["metrics"].push_back(e);
   }
-  // One line per pair: a baseline of a few hundred pairs stays readable.
   std::string text = j.dump(2);
-  static const std::regex pair_object(R"(\{\s+"id": ("[^"]*"),\s+"value": ([^\s}]+)\s+\})");
-  return std::regex_replace(text, pair_object, R"({"id": $1, "value": $2})") + "\n";
+  for (std::size_t i = 0; i < pair_lines.size(); ++i) {
+    const std::string placeholder = fmt::format("\"@pairs {}@\"", i);
+    text.replace(text.find(placeholder), placeholder.size(), pair_lines[i]);
+  }
+  return text + "\n";
 }
 
 fs::path find_results_metrics(const fs::path& results) {

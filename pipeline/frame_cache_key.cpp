@@ -39,38 +39,18 @@ class Fingerprint {
   std::uint64_t h_ = fnv1a64("");
 };
 
-// The scenario's sections that decide the frames, in the order of Scenario::visit.
-struct FrameDecidingSections {
-  explicit FrameDecidingSections(const Scenario& sc)
-      : seed(sc.seed),
-        scene(sc.scene),
-        water(sc.water),
-        vessel(sc.vessel),
-        mission(sc.mission),
-        sensors(sc.sensors),
-        render(sc.render),
-        max_frames(sc.pipeline.max_frames) {}
-  std::uint64_t seed;
-  scenes::SceneOptions scene;
-  sim::WaterOptions water;
-  sim::VesselOptions vessel;
-  sim::MissionOptions mission;
-  sim::SensorOptions sensors;
-  sim::RenderOptions render;
-  int max_frames;
-
-  template <class A>
-  void visit(A& a) {
-    a("seed", seed, "");
-    a("scene", scene, "");
-    a("water", water, "");
-    a("vessel", vessel, "");
-    a("mission", mission, "");
-    a("sensors", sensors, "");
-    a("render", render, "");
-    a("pipeline_max_frames", max_frames, "");
-  }
-};
+// The scenario with what decides no frame put back to its defaults: name, description,
+// evaluation, and the pipeline but for pipeline.max_frames. A section added to Scenario later
+// is in the key until it is named here (a needless miss, never a stale frame).
+Scenario frame_deciding(const Scenario& sc) {
+  Scenario s = sc;
+  s.name = Scenario{}.name;
+  s.description.clear();
+  s.eval = eval::EvalOptions{};
+  s.pipeline = PipelineOptions{};
+  s.pipeline.max_frames = sc.pipeline.max_frames;
+  return s;
+}
 
 }  // namespace
 
@@ -138,7 +118,7 @@ std::string frame_cache_key(const std::string& identity, const Scenario& sc,
       "driftlab frame cache key, version 1\n{}scene_fnv1a64 {}\ntruth_fnv1a64 {}\n"
       "frames {}\n{}",
       identity, scene_fingerprint(scene), truth_fingerprint(truth, stamps), truth.size(),
-      yaml::to_yaml(FrameDecidingSections(sc), false));
+      yaml::to_yaml(frame_deciding(sc), false));
 }
 
 }  // namespace driftlab::pipeline

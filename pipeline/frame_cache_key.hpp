@@ -6,8 +6,9 @@
 //     and flags, computed at build time by cmake/DriftlabRendererIdentity.cmake), the OpenCV
 //     library's version (camera effects), and the GL context's own description (Mesa and LLVM
 //     versions, or the GPU driver's);
-//   - the scenario's frame-deciding sections, resolved (seed, scene, water, vessel, mission,
-//     sensors, render, pipeline.max_frames; never the VOs, filters or evaluation);
+//   - the resolved scenario without what decides no frame (its name and description, the
+//     evaluation, and the pipeline but for pipeline.max_frames): seed, scene, water, vessel,
+//     mission, sensors, render and any section added later;
 //   - fingerprints (FNV-1a 64) of what the run computed from them: the scene geometry as built
 //     (meshes, textures, including photographs read from Debian packages), the true frame
 //     poses and times (so a change of the physics misses too), and the camera clock's stamps

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -519,6 +520,68 @@ nlohmann::ordered_json per_pair_values(const Pool& pool, const std::string& algo
   return pairs;
 }
 
+// The metrics a summary's paired tables show (metrics.json has every one).
+bool shown_paired(const std::string& metric) {
+  for (const char* m : {"p_m_per_m_sections", "ape_trans_rmse_m", "ape_rot_rmse_deg",
+                        "track_length_error_pct", "lost_fraction"})
+    if (metric == m) return true;
+  return false;
+}
+
+// B against A over the pair names both have (`rename` maps a name to the one it pairs under),
+// as metrics.json holds it and as a summary row; nothing when no pair is common.
+struct PairedRow {
+  nlohmann::ordered_json json;
+  std::string md;
+};
+std::optional<PairedRow> paired_row(const std::string& label, const std::string& metric,
+                                    const std::map<std::string, double>& a_values,
+                                    const std::map<std::string, double>& b_values) {
+  std::vector<double> a, b;
+  for (const auto& [id, v] : a_values)
+    if (const auto it = b_values.find(id); it != b_values.end()) {
+      a.push_back(v);
+      b.push_back(it->second);
+    }
+  if (a.empty()) return std::nullopt;
+  const gate::PairedChange c = gate::paired_change(a, b);
+  const double p_two = std::min(1.0, 2 * std::min(c.test.p_greater, c.test.p_less));
+  PairedRow r;
+  r.json = {{"pairs", c.n},
+            {"mean_a", c.mean_a},
+            {"mean_b", c.mean_b},
+            {"diff", c.diff},
+            {"diff_ci95", {c.diff_lo, c.diff_hi}},
+            {"rel", c.rel},
+            {"rel_ci95", {c.rel_lo, c.rel_hi}},
+            {"p_signed_rank", p_two}};
+  r.md = fmt::format("| {} | {} | {} | {:.4g} | {:.4g} | {:+.1f}% [{:+.1f}, {:+.1f}] | {:.2g} |\n",
+                     label, metric, c.n, c.mean_a, c.mean_b, 100 * c.rel, 100 * c.rel_lo,
+                     100 * c.rel_hi, p_two);
+  return r;
+}
+
+// The values of one paired metric by pair name; with `point`: only that point's jobs (job
+// names, not sections), named by their replicate ("-r01").
+std::map<std::string, double> pair_values(const nlohmann::ordered_json& values,
+                                          std::optional<std::string> point = std::nullopt) {
+  std::map<std::string, double> out;
+  for (const auto& [id, v] : values.items()) {
+    if (!point) {
+      out[id] = v.get<double>();
+      continue;
+    }
+    const auto dash = id.find('-');
+    if (id.find('/') == std::string::npos && dash != std::string::npos &&
+        id.substr(0, dash) == *point)
+      out[id.substr(dash)] = v.get<double>();
+  }
+  return out;
+}
+
+const char* kPairedHead =
+    "| B vs A | metric | pairs | A | B | B - A | p |\n|---|---|---|---|---|---|---|\n";
+
 // A/B statistics of every two algorithms on the same jobs (issue 43): for each paired metric,
 // the mean of B - A over the pairs both have (sections by JOB/INDEX, run metrics by job) with
 // its 95 % interval and the two-sided Wilcoxon signed-rank p-value (gate/paired.hpp).
@@ -529,49 +592,61 @@ Part paired_algorithms(const nlohmann::ordered_json& algorithms) {
   for (const auto& [name, a] : algorithms.items())
     if (a.contains("pairs")) names.push_back(name);
   if (names.size() < 2) return p;
-  const auto shown = [](const std::string& metric) {
-    for (const char* m : {"p_m_per_m_sections", "ape_trans_rmse_m", "ape_rot_rmse_deg",
-                          "track_length_error_pct", "lost_fraction"})
-      if (metric == m) return true;
-    return false;
-  };
-  p.md =
-      "\n## Paired comparisons\n\nEach row compares B with A on the same jobs (and sections): "
-      "the mean of B - A over the pairs both have, relative to A's mean, with its 95% "
-      "interval, and the two-sided signed-rank p-value (every metric: metrics.json "
-      "`paired`).\n\n| B vs A | metric | pairs | A | B | "
-      "B - A | p |\n|---|---|---|---|---|---|---|\n";
+  p.md = std::string(
+             "\n## Paired comparisons of the algorithms\n\nEach row compares B with A on the "
+             "same jobs (and sections): the mean of B - A over the pairs both have, relative to "
+             "A's mean, with its 95% interval, and the two-sided signed-rank p-value (every "
+             "metric: metrics.json `paired`).\n\n") +
+         kPairedHead;
   for (std::size_t i = 0; i < names.size(); ++i)
     for (std::size_t j = i + 1; j < names.size(); ++j) {
       const std::string label = names[j] + " vs " + names[i];
+      const auto& b_all = algorithms[names[j]]["pairs"];
       for (const auto& [metric, a_values] : algorithms[names[i]]["pairs"].items()) {
-        const auto& b_values = algorithms[names[j]]["pairs"];
-        if (!b_values.contains(metric)) continue;
-        std::vector<double> a, b;
-        for (const auto& [id, v] : a_values.items())
-          if (b_values[metric].contains(id)) {
-            a.push_back(v.get<double>());
-            b.push_back(b_values[metric][id].get<double>());
-          }
-        if (a.empty()) continue;
-        const gate::PairedChange c = gate::paired_change(a, b);
-        const double p_two = std::min(1.0, 2 * std::min(c.test.p_greater, c.test.p_less));
-        p.json[label][metric] = {{"pairs", c.n},
-                                 {"mean_a", c.mean_a},
-                                 {"mean_b", c.mean_b},
-                                 {"diff", c.diff},
-                                 {"diff_ci95", {c.diff_lo, c.diff_hi}},
-                                 {"rel", c.rel},
-                                 {"rel_ci95", {c.rel_lo, c.rel_hi}},
-                                 {"p_signed_rank", p_two}};
-        if (!shown(metric)) continue;  // metrics.json has them all
-        p.md += fmt::format(
-            "| {} | {} | {} | {:.4g} | {:.4g} | {:+.1f}% [{:+.1f}, {:+.1f}] | "
-            "{:.2g} |\n",
-            label, metric, c.n, c.mean_a, c.mean_b, 100 * c.rel, 100 * c.rel_lo, 100 * c.rel_hi,
-            p_two);
+        if (!b_all.contains(metric)) continue;
+        const auto row =
+            paired_row(label, metric, pair_values(a_values), pair_values(b_all[metric]));
+        if (!row) continue;
+        p.json[label][metric] = row->json;
+        if (shown_paired(metric)) p.md += row->md;
       }
     }
+  return p;
+}
+
+// Each point against the first, per algorithm, on the replicates both ran: the replicates of
+// every point share their seeds (common random numbers), so the runs pair by replicate. Run
+// metrics only: an axis that moves the vessel moves the sections too. The summary shows them
+// for sweeps of at most 8 points.
+Part paired_points(const nlohmann::ordered_json& algorithms, const Pool& pool) {
+  Part p;
+  p.json = nlohmann::ordered_json::object();
+  std::vector<std::string> points;
+  for (const auto& r : pool.runs) {
+    const std::string pid = fmt::format("p{:04}", r.job->point);
+    if (std::find(points.begin(), points.end(), pid) == points.end()) points.push_back(pid);
+  }
+  if (points.size() < 2) return p;
+  const bool show = points.size() <= 8;
+  if (show)
+    p.md = std::string(
+               "\n## Paired comparisons of the points\n\nEach point against the first on the "
+               "same replicates (their seeds are shared): as above, per algorithm (metrics.json "
+               "`paired_points`; the points' parameters: `points`).\n\n") +
+           kPairedHead;
+  for (const auto& [algo, a] : algorithms.items()) {
+    if (!a.contains("pairs")) continue;
+    for (std::size_t k = 1; k < points.size(); ++k) {
+      const std::string label = algo + ": " + points[k] + " vs " + points[0];
+      for (const auto& [metric, values] : a["pairs"].items()) {
+        const auto row = paired_row(label, metric, pair_values(values, points[0]),
+                                    pair_values(values, points[k]));
+        if (!row || metric == "p_m_per_m_sections") continue;
+        p.json[algo][points[k] + " vs " + points[0]][metric] = row->json;
+        if (show && shown_paired(metric)) p.md += row->md;
+      }
+    }
+  }
   return p;
 }
 
@@ -861,6 +936,9 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
   Part paired = paired_algorithms(metrics["algorithms"]);
   metrics["paired"] = std::move(paired.json);
   md += paired.md;
+  Part paired_pts = paired_points(metrics["algorithms"], pool);
+  metrics["paired_points"] = std::move(paired_pts.json);
+  md += paired_pts.md;
   const Points points = per_point(m, pool);
   metrics["points"] = points.json;
   md += points.md;

@@ -881,12 +881,12 @@ TEST(SweepCli, BuiltInAndExternalVoSideBySideMergeIntoOneTable) {
 TEST(SweepCli, JobsDifferingOnlyInVoOptionsRenderTheirFramesOnce) {
   // Issue 43: two VO settings x two replicates, two jobs at once, one frame cache: each
   // replicate's frames (its seed) are rendered by one job and replayed by the other, even when
-  // both start together.
+  // both start together. Then the merge's paired comparisons of the VOs and of the settings.
   const fs::path root = temp_dir("vo_only");
   fs::create_directories(root);
   std::ofstream(root / "sweep.yaml")
       << "name: tiny_vo_only\nbase: " << (kSweeps / "tiny_base.yaml").string()
-      << "\nseed: 5\ndesign: grid\nreplicates: 2\nset:\n  pipeline.fusion: []\naxes:\n"
+      << "\nseed: 5\ndesign: grid\nreplicates: 2\naxes:\n"
          "  - key: pipeline.sparse.ransac_iterations\n    name: ransac\n    values: [200, 50]\n";
   Result r =
       run_cli({"sweep", "plan", (root / "sweep.yaml").string(), "--out", (root / "plan").string()});
@@ -905,6 +905,32 @@ TEST(SweepCli, JobsDifferingOnlyInVoOptionsRenderTheirFramesOnce) {
     EXPECT_EQ(s, (std::multiset<std::string>{"filled", "hit"})) << entry;
     EXPECT_TRUE(fs::exists(fs::path(entry) / "index.csv")) << entry;
   }
+
+  // The merge's paired comparisons against the runs' own metrics.json: sparse_ca against
+  // sparse on the four jobs, and the second RANSAC setting against the first on the two
+  // replicates.
+  r = run_cli({"sweep", "merge", (root / "plan").string(), "--no-plots"});
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const auto merged = nlohmann::json::parse(slurp(root / "plan" / "summary" / "metrics.json"));
+  auto ape = [&](const char* job, const char* algo) {
+    const auto m = nlohmann::json::parse(slurp(root / "plan" / "runs" / job / "metrics.json"));
+    return m["algorithms"][algo]["ape"]["trans_m"]["rmse"].get<double>();
+  };
+  double diff = 0;
+  for (const char* job : {"p0000-r00", "p0000-r01", "p0001-r00", "p0001-r01"})
+    diff += (ape(job, "sparse_ca") - ape(job, "sparse")) / 4;
+  const auto& vo = merged["paired"]["sparse_ca vs sparse"]["ape_trans_rmse_m"];
+  EXPECT_EQ(vo["pairs"], 4);
+  EXPECT_NEAR(vo["diff"].get<double>(), diff, 1e-12);
+  const auto& pt = merged["paired_points"]["sparse"]["p0001 vs p0000"]["ape_trans_rmse_m"];
+  EXPECT_EQ(pt["pairs"], 2);
+  EXPECT_NEAR(pt["mean_a"].get<double>(),
+              (ape("p0000-r00", "sparse") + ape("p0000-r01", "sparse")) / 2, 1e-12);
+  EXPECT_NEAR(pt["mean_b"].get<double>(),
+              (ape("p0001-r00", "sparse") + ape("p0001-r01", "sparse")) / 2, 1e-12);
+  EXPECT_NE(
+      slurp(root / "plan" / "summary" / "summary.md").find("## Paired comparisons of the points"),
+      std::string::npos);
   fs::remove_all(root);
 }
 
