@@ -152,6 +152,15 @@ TEST(Cli, RunWritesAtomicallyAndRefusesToOverwrite) {
   const fs::path out2 = dir / "out2";
   r = run_cli({"run", file, "--out", out2.string(), "--set", "seed=-4"});
   EXPECT_EQ(r.exit_code, 1);
+  // So does a bad frame cache size: the message names the variable, its value and what was
+  // expected, and neither the run nor the cache folder appears.
+  r = run_cli({"run", file, "--out", out2.string(), "--frame-cache", (dir / "frames").string()},
+              "DRIFTLAB_FRAME_CACHE_GIB=lots");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("DRIFTLAB_FRAME_CACHE_GIB: got 'lots', expected the frame cache's size "
+                          "in GiB, a number above 0"),
+            std::string::npos)
+      << r.output;
   for (const auto& e : fs::directory_iterator(dir))
     EXPECT_EQ(e.path().filename(), "out") << "left behind: " << e.path();
   fs::remove_all(dir);
