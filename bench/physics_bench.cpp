@@ -5,6 +5,7 @@
 #include "core/rng.hpp"
 #include "sim/vessel/guidance.hpp"
 #include "sim/vessel/simulator.hpp"
+#include "sim/waves/ripple_spectrum.hpp"
 #include "sim/waves/wave_field.hpp"
 
 namespace {
@@ -50,6 +51,22 @@ void BM_PhysicsStepJonswap(benchmark::State& state) {
   step_bench(state, w);
 }
 BENCHMARK(BM_PhysicsStepJonswap);
+
+// The wind ripples' slope maps of one time step (both tiles, 256x256, FFT and
+// mip levels): the river paper's breeze at the water (4.4 m/s, shelter 0.25).
+void BM_RippleMapsBake(benchmark::State& state) {
+  WindOptions w;
+  w.speed_mps = 4.4;
+  w.shelter = 0.25;
+  RippleMaps maps(w, CurrentOptions{}, driftlab::RngStreams(1).stream("water.ripples"));
+  double t = 0.0;
+  for (auto _ : state) {
+    maps.bake(t);
+    t += 1.0 / 8.2;
+    benchmark::DoNotOptimize(maps.level(1, 0).data());
+  }
+}
+BENCHMARK(BM_RippleMapsBake)->Unit(benchmark::kMillisecond);
 
 void BM_Survey663m(benchmark::State& state) {
   const VesselModel model(VesselOptions{});

@@ -44,7 +44,8 @@ std::string RenderSequenceSummary::brief() const {
 void set_water_surface(sim::StereoRenderer* renderer, const Scenario& sc) {
   const RngStreams rng(sc.seed);
   renderer->set_waves(sim::wave_components(sc.water.waves, rng.stream("waves.phases")));
-  renderer->set_ripples(sim::wind_ripples(sc.water.wind, rng.stream("water.ripples")));
+  renderer->set_ripples(std::make_shared<sim::RippleMaps>(sc.water.wind, sc.water.current,
+                                                          rng.stream("water.ripples")));
 }
 
 StereoRig rig_of(const sim::CameraOptions& c) {

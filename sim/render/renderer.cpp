@@ -9,8 +9,11 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <map>
+#include <memory>
 #include <numbers>
+#include <string>
 #include <tuple>
 
 #include "core/error.hpp"
@@ -97,9 +100,9 @@ struct StereoRenderer::Impl {
   float wave_amplitude_sum_m = 0;
   std::vector<float> wave_a;  // 4 per component
   std::vector<float> wave_phase;
-  std::vector<WaveComponent> ripples;  // longest first
-  std::vector<float> ripple_a;         // 4 per ripple: kx, ky, a kx / |k|, a ky / |k|
-  std::vector<float> ripple_scale;     // 3 per ripple: wavelength, (a k)^2 / 2, its suffix sum
+  std::shared_ptr<RippleMaps> ripples;  // the wind ripples' slope maps (null: none)
+  std::array<GLuint, RippleMaps::kTiles> ripple_tex = {};
+  double ripple_t = std::numeric_limits<double>::quiet_NaN();  // the time the textures show
   int refl_levels = 1;
   int refl_width = 0, refl_height = 0;  // the reflection pass's size
   // Framebuffers.
@@ -130,6 +133,8 @@ struct StereoRenderer::Impl {
   void draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, double t, int mode,
                   GLuint reflection);  // 0: none
   void draw_sky(const Eigen::Matrix4f& view);
+  // The ripples' slope maps at time t into ripple_tex (once per t).
+  void upload_ripples(double t);
   bool reflects() const { return scene.water.enabled && options.reflections; }
   // The scene mirrored in the water plane for one eye, into its reflection texture.
   void draw_reflection(const SE3& T_W_C, int eye);
@@ -395,42 +400,48 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
   m.scene.water = scene.water;
 }
 
-void StereoRenderer::set_ripples(const std::vector<WaveComponent>& components) {
+void StereoRenderer::set_ripples(std::shared_ptr<RippleMaps> maps) {
   Impl& m = *impl_;
-  std::vector<WaveComponent> c = components;
-  if (c.size() > static_cast<std::size_t>(kMaxShaderRipples)) c.resize(kMaxShaderRipples);
-  // Longest first, so that the shader stops at the first ripple too short to
-  // resolve and takes the slope variance of the rest from the suffix sum.
-  std::stable_sort(c.begin(), c.end(), [](const WaveComponent& a, const WaveComponent& b) {
-    return a.wavenumber_rad_m < b.wavenumber_rad_m;
-  });
-  m.ripples = c;
-  m.ripple_a.clear();
-  m.ripple_scale.assign(3 * c.size(), 0.f);
-  double suffix = 0.0;
-  for (std::size_t i = c.size(); i-- > 0;) {
-    const double ak = c[i].amplitude_m * c[i].wavenumber_rad_m;
-    suffix += 0.5 * ak * ak;
-    m.ripple_scale[3 * i] = static_cast<float>(2.0 * std::numbers::pi / c[i].wavenumber_rad_m);
-    m.ripple_scale[3 * i + 1] = static_cast<float>(0.5 * ak * ak);
-    m.ripple_scale[3 * i + 2] = static_cast<float>(suffix);
-  }
-  for (const auto& w : c) {
-    const double kx = w.wavenumber_rad_m * std::cos(w.direction_rad),
-                 ky = w.wavenumber_rad_m * std::sin(w.direction_rad);
-    const double ak = w.amplitude_m * w.wavenumber_rad_m;
-    m.ripple_a.insert(m.ripple_a.end(), {static_cast<float>(kx), static_cast<float>(ky),
-                                         static_cast<float>(ak * std::cos(w.direction_rad)),
-                                         static_cast<float>(ak * std::sin(w.direction_rad))});
+  m.context->make_current();
+  if (maps && maps->empty()) maps.reset();
+  m.ripples = std::move(maps);
+  m.ripple_t = std::numeric_limits<double>::quiet_NaN();
+  const bool none = !m.ripples;
+  if (!none && m.ripple_tex[0] == 0) {
+    // Float moments, mip mapped (the levels come from RippleMaps), repeating.
+    glGenTextures(RippleMaps::kTiles, m.ripple_tex.data());
+    for (GLuint tex : m.ripple_tex) {
+      glBindTexture(GL_TEXTURE_2D, tex);
+      glTexStorage2D(GL_TEXTURE_2D, m.ripples->levels(), GL_RGBA32F, RippleMaps::kResolution,
+                     RippleMaps::kResolution);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    }
   }
   // The mirror image is sampled from its mip levels only when ripples blur it.
-  m.context->make_current();
   for (const auto& e : m.eyes) {
     glBindTexture(GL_TEXTURE_2D, e.refl_tex);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
-                    c.empty() ? GL_LINEAR : GL_LINEAR_MIPMAP_LINEAR);
+                    none ? GL_LINEAR : GL_LINEAR_MIPMAP_LINEAR);
   }
   glBindTexture(GL_TEXTURE_2D, 0);
+}
+
+void StereoRenderer::Impl::upload_ripples(double t) {
+  if (ripple_t == t) return;
+  ripples->bake(t);
+  for (int tile = 0; tile < RippleMaps::kTiles; ++tile) {
+    glBindTexture(GL_TEXTURE_2D, ripple_tex[static_cast<std::size_t>(tile)]);
+    for (int l = 0; l < ripples->levels(); ++l) {
+      const int n = RippleMaps::kResolution >> l;
+      glTexSubImage2D(GL_TEXTURE_2D, l, 0, 0, n, n, GL_RGBA, GL_FLOAT,
+                      ripples->level(tile, l).data());
+    }
+  }
+  glBindTexture(GL_TEXTURE_2D, 0);
+  ripple_t = t;
 }
 
 void StereoRenderer::set_waves(const std::vector<WaveComponent>& components) {
@@ -515,7 +526,7 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   if (!scene.water.enabled) return;
   const Lighting& L = scene.lighting;
   const WaterAppearance& w = scene.water;
-  const GLuint water_prog = water_progs[mode][L.sun ? 1 : 0][ripples.empty() ? 0 : 1];
+  const GLuint water_prog = water_progs[mode][L.sun ? 1 : 0][ripples ? 1 : 0];
   glUseProgram(water_prog);
   set_mat4(water_prog, "u_view", view);
   set_mat4(water_prog, "u_proj", proj);
@@ -539,17 +550,20 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   glUniform1f(loc(water_prog, "u_fog"), L.fog_distance_m);
   const Eigen::Vector3f sun = L.sun_direction_W.normalized();
   glUniform3f(loc(water_prog, "u_sun_dir"), sun.x(), sun.y(), sun.z());
-  const int n_ripples = static_cast<int>(ripples.size());
-  glUniform1i(loc(water_prog, "u_ripple_count"), n_ripples);
-  if (n_ripples > 0) {
-    // Phases at time t in double precision, reduced to [0, 2 pi).
-    std::vector<float> phase;
-    for (const WaveComponent& r : ripples)
-      phase.push_back(static_cast<float>(
-          std::remainder(r.phase_rad - r.omega_rad_s * t, 2.0 * std::numbers::pi)));
-    glUniform4fv(loc(water_prog, "u_ripple"), n_ripples, ripple_a.data());
-    glUniform3fv(loc(water_prog, "u_ripple_scale"), n_ripples, ripple_scale.data());
-    glUniform1fv(loc(water_prog, "u_ripple_phase"), n_ripples, phase.data());
+  if (ripples && mode == 0) {
+    upload_ripples(t);
+    // Texture coordinates relative to the eye, the eye's own reduced in double.
+    for (int tile = 0; tile < RippleMaps::kTiles; ++tile) {
+      const double L = ripples->tile_size_m(tile);
+      const std::string i = std::to_string(tile);
+      glUniform1f(loc(water_prog, ("u_ripple_inv_size" + i).c_str()), static_cast<float>(1.0 / L));
+      glUniform2f(loc(water_prog, ("u_ripple_offset" + i).c_str()),
+                  static_cast<float>(std::remainder(double(eye.x()), L) / L),
+                  static_cast<float>(std::remainder(double(eye.y()), L) / L));
+      glUniform1i(loc(water_prog, ("u_ripple_map" + i).c_str()), 1 + tile);
+      glActiveTexture(static_cast<GLenum>(GL_TEXTURE1 + tile));
+      glBindTexture(GL_TEXTURE_2D, ripple_tex[static_cast<std::size_t>(tile)]);
+    }
   }
   glUniform2f(loc(water_prog, "u_focal"), static_cast<float>(rig.camera.fx),
               static_cast<float>(rig.camera.fy));
@@ -640,7 +654,7 @@ void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, int eye_index) {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.refl_fbo);
     glBlitFramebuffer(0, 0, RW, RH, 0, 0, RW, RH, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
-  if (!ripples.empty()) mip_chain->build(e.refl_tex, RW, RH, refl_levels);
+  if (ripples) mip_chain->build(e.refl_tex, RW, RH, refl_levels);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 

@@ -21,6 +21,7 @@
 #include "sim/render/gl_context.hpp"
 #include "sim/render/render_options.hpp"
 #include "sim/render/scene_geometry.hpp"
+#include "sim/waves/ripple_spectrum.hpp"
 #include "sim/waves/wave_field.hpp"
 
 namespace driftlab::sim {
@@ -51,8 +52,6 @@ Eigen::Matrix4f projection_from_intrinsics(const PinholeCamera& camera, float ne
 
 /// Largest number of wave components the water shader sums (the strongest are kept).
 constexpr int kMaxShaderWaveComponents = 32;
-/// Largest number of wind-ripple components the water shader sums.
-constexpr int kMaxShaderRipples = 16;
 
 class StereoRenderer {
  public:
@@ -67,10 +66,10 @@ class StereoRenderer {
   void upload(const SceneGeometry& scene);
   /// The wave components the water surface shows (calm when empty).
   void set_waves(const std::vector<WaveComponent>& components);
-  /// The wind ripples (sim::wind_ripples) that break the mirror image up:
-  /// drawn in the shading only, not in the geometry or the depth (none when
-  /// empty, the default).
-  void set_ripples(const std::vector<WaveComponent>& components);
+  /// The wind ripples that break the mirror image up (sim::RippleMaps, baked
+  /// at each frame's time and shared by both eyes): drawn in the shading only,
+  /// not in the geometry or the depth (none when null or empty, the default).
+  void set_ripples(std::shared_ptr<RippleMaps> maps);
   /// Where the right camera really is relative to the left (a miscalibrated
   /// rig: see sim::true_T_left_right); the rig's nominal baseline by default.
   void set_right_camera(const SE3& T_left_right);

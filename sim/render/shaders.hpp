@@ -217,14 +217,15 @@ in vec3 v_normal;
 #if RIPPLES && !DEPTH
 in vec4 v_jacobian;
 #endif
-const int R = 16;
-// Ripples, longest first: wave vector k; slope amplitude a k along k / |k|;
-// wavelength; half the slope variance; the latter summed over this ripple and
-// all shorter ones; phase at this frame's time.
-uniform vec4 u_ripple[R];       // kx, ky, a kx / |k|, a ky / |k|
-uniform vec3 u_ripple_scale[R]; // wavelength [m], (a k)^2 / 2, its sum from here on
-uniform float u_ripple_phase[R];
-uniform int u_ripple_count;
+// Wind ripples (sim/waves/ripple_spectrum.hpp): two repeating tiles of slope
+// moments (sx, sy, sx^2, sy^2), each with its inverse size [1/m] and the eye's
+// position in it (in tiles, reduced on the CPU in double).
+uniform sampler2D u_ripple_map0;
+uniform sampler2D u_ripple_map1;
+uniform float u_ripple_inv_size0;
+uniform float u_ripple_inv_size1;
+uniform vec2 u_ripple_offset0;
+uniform vec2 u_ripple_offset1;
 uniform mat4 u_view;
 uniform vec2 u_focal;           // fx, fy [px]
 uniform float u_refl_max_lod;
@@ -255,23 +256,17 @@ void main() {
   if (u_has_reflection) {
     vec2 uv = gl_FragCoord.xy / u_viewport + 0.15 * v_shade.xy * vec2(1.0, -1.0);
 #if RIPPLES
-    // Wind ripples: those at least 4 pixels long are drawn, fading out
-    // below (so they never alias); the slope variance of the shorter ones
-    // blurs the reflection instead, as a rough mirror does.
-    vec2 xy = v_world.xy;
-    float foot = max(length(dFdx(xy)), length(dFdy(xy)));  // water surface per pixel [m]
-    vec2 slope = vec2(0.0);
-    float unresolved = 0.0;
-    for (int i = 0; i < u_ripple_count; ++i) {
-      float cycles_px = u_ripple_scale[i].x / foot;  // pixels per wavelength
-      if (cycles_px < 2.0) {  // this one and all shorter ones are unresolved
-        unresolved += u_ripple_scale[i].z;
-        break;
-      }
-      float keep = smoothstep(2.0, 4.0, cycles_px);
-      slope -= keep * sin(dot(u_ripple[i].xy, xy) + u_ripple_phase[i]) * u_ripple[i].zw;
-      unresolved += (1.0 - keep * keep) * u_ripple_scale[i].y;
-    }
+    // Wind ripples: the mip-mapped moments averaged over this pixel's
+    // footprint. Their mean slope tilts the reflected ray; their variance
+    // less the square of the mean is the slope variance of the ripples the
+    // footprint averages away, which blurs the reflection instead, as a rough
+    // mirror does (LEAN mapping, Olano and Baker 2010).
+    vec2 rel = v_world.xy - u_eye.xy;
+    vec4 m0 = texture(u_ripple_map0, rel * u_ripple_inv_size0 + u_ripple_offset0);
+    vec4 m1 = texture(u_ripple_map1, rel * u_ripple_inv_size1 + u_ripple_offset1);
+    vec2 slope = m0.xy + m1.xy;
+    float unresolved = max(m0.z + m0.w - dot(m0.xy, m0.xy), 0.0)
+                     + max(m1.z + m1.w - dot(m1.xy, m1.xy), 0.0);
     // Where the reflected ray through the rippled surface lands in the
     // mirror image, against the ray through the flat surface: exact for
     // the reflection of distant objects.

@@ -431,33 +431,6 @@ std::vector<WaveComponent> wave_components(const WaveOptions& options, Rng rng) 
 
 double ripple_mean_square_slope(double u_mps) { return 1.56e-3 * std::max(0.0, u_mps); }
 
-std::vector<WaveComponent> wind_ripples(const WindOptions& options, Rng rng, int count) {
-  yaml::validate_or_throw(options, "water.wind");
-  DRIFTLAB_DEMAND_MSG(count > 0, "wind_ripples needs count > 0");
-  const double u = options.speed_mps * options.shelter;
-  if (u <= 0.0) return {};
-  constexpr double kSurfaceTension_m3_s2 = 7.3e-5;  // T / rho of water at 15 C
-  const double slope_sd = std::sqrt(ripple_mean_square_slope(u));
-  // Equal slope variance per component: s^2 / 2 each, summing to sigma^2.
-  const double slope_amplitude = slope_sd * std::sqrt(2.0 / count);
-  const double lambda_min = 0.02, lambda_max = 0.5;
-  std::vector<WaveComponent> out;
-  out.reserve(static_cast<std::size_t>(count));
-  for (int i = 0; i < count; ++i) {
-    const double f = count > 1 ? static_cast<double>(i) / (count - 1) : 0.5;
-    const double lambda = lambda_min * std::pow(lambda_max / lambda_min, f);
-    WaveComponent c;
-    c.wavenumber_rad_m = 2.0 * kPi / lambda;
-    const double k = c.wavenumber_rad_m;
-    c.omega_rad_s = std::sqrt(kGravity_m_s2 * k + kSurfaceTension_m3_s2 * k * k * k);
-    c.amplitude_m = slope_amplitude / k;  // slope amplitude a k
-    c.direction_rad = deg_to_rad(options.direction_deg) + deg_to_rad(rng.uniform(-70.0, 70.0));
-    c.phase_rad = rng.uniform(0.0, 2.0 * kPi);
-    out.push_back(c);
-  }
-  return out;
-}
-
 std::unique_ptr<WaveField> make_wave_field(const WaveOptions& options, Rng rng) {
   std::vector<WaveComponent> components = wave_components(options, std::move(rng));
   if (options.model == WaveModel::kCalm) return std::make_unique<CalmField>();

@@ -73,14 +73,6 @@ std::vector<WaveComponent> wave_components(const WaveOptions& options, Rng rng);
 /// river does not have).
 double ripple_mean_square_slope(double u_mps);
 
-/// The short capillary-gravity ripples the wind raises: `count` components
-/// of wavelengths spread evenly in log from 2 cm to 0.5 m, directions within
-/// +-70 deg of the wind, dispersion omega^2 = g k + (T / rho) k^3, and equal
-/// slope variance each, summing to ripple_mean_square_slope() (a saturated
-/// short-wave range, whose slope spectrum is flat per log wavenumber). Empty
-/// without wind. For the renderer only.
-std::vector<WaveComponent> wind_ripples(const WindOptions& options, Rng rng, int count = 12);
-
 /// JONSWAP spectral density S(omega) [m^2 s/rad] of significant height hs [m],
 /// peak period tp [s] and peak enhancement gamma >= 1 (Hasselmann et al. 1973,
 /// in the form of DNV-RP-C205 Sec. 3.5.5); 0 for omega <= 0.

@@ -111,6 +111,12 @@ struct CurrentOptions {
   }
 };
 
+enum class RippleLevel { kSlick, kSpectrum };
+constexpr auto enum_table(RippleLevel) {
+  return std::array{std::pair{RippleLevel::kSlick, "slick"},
+                    std::pair{RippleLevel::kSpectrum, "spectrum"}};
+}
+
 /// Wind over the water. It raises the short capillary-gravity ripples that
 /// break a river's mirror image up; they are drawn by the renderer only (the
 /// vessel physics does not feel them, and the wind exerts no force).
@@ -118,6 +124,8 @@ struct WindOptions {
   double speed_mps = 0.0;
   double direction_deg = 0.0;
   double shelter = 1.0;
+  double fetch_m = 100.0;
+  RippleLevel ripple_level = RippleLevel::kSlick;
 
   template <class A>
   void visit(A& a) {
@@ -131,6 +139,15 @@ struct WindOptions {
       "Fraction of the wind speed that reaches the water (banks and trees shelter a river); "
       "1: open water",
       yaml::in_range(0, 1));
+    a("fetch_m", fetch_m,
+      "Fetch: the open water upwind over which the wind raises the ripples [m]; it sets the "
+      "ripple spectrum's peak (Elfouhaily et al. 1997)",
+      yaml::at_least(1) & yaml::up_to(1e6, "longer than any ocean fetch"));
+    a("ripple_level", ripple_level,
+      "What sets the ripples' mean square slope: 'slick', Cox and Munk's slick-surface wind "
+      "term 1.56e-3 U at the wind reaching the water (it falls to glassy water in light air); "
+      "'spectrum', the integral of Elfouhaily et al.'s spectrum (fitted for U of 3 m/s and "
+      "more; about 0.01 even in light air at a short fetch)");
   }
 };
 

@@ -238,11 +238,12 @@ TYPED_TEST(RenderTest, WindRipplesBreakTheMirrorImageOnlyOnTheWater) {
   const StereoImages calm = this->renderer_->render(T_W_C, 2.0, false);
   WindOptions w;
   w.speed_mps = 3.0;
-  this->renderer_->set_ripples(wind_ripples(w, RngStreams(3).stream("water.ripples")));
+  this->renderer_->set_ripples(
+      std::make_shared<RippleMaps>(w, CurrentOptions{}, RngStreams(3).stream("water.ripples")));
   const StereoImages rippled = this->renderer_->render(T_W_C, 2.0, false);
   const StereoImages later = this->renderer_->render(T_W_C, 2.5, false);
   const StereoImages rippled_again = this->renderer_->render(T_W_C, 2.0, false);
-  this->renderer_->set_ripples({});
+  this->renderer_->set_ripples(nullptr);
   const StereoImages calm_again = this->renderer_->render(T_W_C, 2.0, false);
   EXPECT_EQ(calm.left.pixels, calm_again.left.pixels);
   EXPECT_EQ(rippled.left.pixels, rippled_again.left.pixels);
