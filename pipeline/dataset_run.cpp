@@ -248,14 +248,14 @@ void finish_tracks(const PipelineOptions& pipeline, const std::vector<dataset::D
 std::vector<std::string> evaluate_tracks(const dataset::StereoDataset& d, const Scenario& settings,
                                          const std::vector<Track>& tracks,
                                          const std::vector<dataset::DatasetFrame>& used,
-                                         const fs::path& dir, nlohmann::json* metrics,
+                                         const fs::path& dir, TrackRecords* records,
                                          std::vector<std::string>* warnings) {
   std::vector<std::string> briefs;
   std::string tables, sections;
   for (const Track& t : tracks) {
     if (t.vo)
-      add_vo_timing(*t.vo, t.name, used.empty() ? 0.0 : t.vo_ms / static_cast<double>(used.size()),
-                    metrics);
+      records->vo_timing[t.name] =
+          vo_timing(*t.vo, used.empty() ? 0.0 : t.vo_ms / static_cast<double>(used.size()));
     if (d.camera_gt.empty()) {
       briefs.push_back(t.name + ": no ground truth, estimate only");
       continue;
@@ -269,14 +269,14 @@ std::vector<std::string> evaluate_tracks(const dataset::StereoDataset& d, const 
     in.options = settings.eval;
     in.frames = covariates(t.vo ? t : tracks[t.source], used);
     const eval::Evaluation e = eval::evaluate(in);
-    (*metrics)["algorithms"][t.name] = eval::to_json(e, settings.eval);
+    records->algorithms[t.name].evaluation = eval::to_json(e, settings.eval);
     tables += eval::tables_markdown(e, settings.eval) + "\n";
     const std::string csv = eval::sections_csv(e);
     sections += sections.empty() ? csv : csv.substr(csv.find('\n') + 1);
     briefs.push_back(e.brief());
   }
-  if (!d.camera_gt.empty()) tables += compare_filters_with_raw_vo(tracks, metrics, warnings);
-  report_filter_counts(tracks, metrics, warnings);
+  if (!d.camera_gt.empty()) tables += compare_filters_with_raw_vo(tracks, records, warnings);
+  report_filter_counts(tracks, records, warnings);
   if (!sections.empty()) write_file_atomic(dir / "sections.csv", sections);
   write_file_atomic(dir / "tables.md",
                     fmt::format("# driftlab vo: {}\n\n{}", d.root.string(), tables));
@@ -300,6 +300,18 @@ nlohmann::json dataset_record(const dataset::StereoDataset& d, std::size_t used,
 
 }  // namespace
 
+nlohmann::json DatasetRunSummary::to_json() const {
+  nlohmann::json m;
+  m["version"] = DRIFTLAB_VERSION;
+  m["seed"] = seed;
+  m["dataset"] = dataset;
+  if (filters_world) m["filters_world"] = *filters_world;
+  tracks.add_to(&m);
+  m["timing"]["total_s"] = total_s;
+  m["warnings"] = warnings;
+  return m;
+}
+
 std::string DatasetRunSummary::brief() const {
   std::string s = fmt::format("{} stereo frames in {:.2f} s", frames, total_s);
   for (const auto& a : algorithms) s += "\n  " + a;
@@ -312,7 +324,6 @@ DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario
   const auto t0 = SteadyClock::now();
   AtomicDirectory dir(out_dir, options.replace_existing);
   write_file_atomic(dir.path() / "scenario.resolved.yaml", resolved_yaml(settings));
-  nlohmann::json metrics;
   DatasetRunSummary summary;
   const auto [first, T_W_C0] = first_anchored(d);
   std::size_t end = d.frames.size();
@@ -326,7 +337,7 @@ DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario
   });
   if (gravity && !d.imu.empty() && !used.empty()) {
     world = level_world(d.imu, T_W_C0 * d.T_S_C.inverse(), used.front().t_ns);
-    metrics["filters_world"] = world.to_json();
+    summary.filters_world = world.to_json();
     if (world.tilt_deg > 2.0)
       summary.warnings.push_back(fmt::format(
           "the dataset's world is tilted {:.1f} deg from gravity; the filters take {} as down",
@@ -341,16 +352,13 @@ DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario
   finish_tracks(settings.pipeline, used, levelled ? world.R_N_W : Mat3::Identity(), &tracks);
   write_estimates(tracks, dir.path());
   if (!d.camera_gt.empty()) write_tum(dir.path() / "groundtruth.tum", d.camera_gt);
-  metrics["version"] = DRIFTLAB_VERSION;
-  metrics["seed"] = settings.seed;
-  metrics["dataset"] = dataset_record(d, used.size(), first);
+  summary.seed = settings.seed;
+  summary.dataset = dataset_record(d, used.size(), first);
   summary.frames = used.size();
   summary.algorithms =
-      evaluate_tracks(d, settings, tracks, used, dir.path(), &metrics, &summary.warnings);
+      evaluate_tracks(d, settings, tracks, used, dir.path(), &summary.tracks, &summary.warnings);
   summary.total_s = seconds_since(t0);
-  metrics["timing"]["total_s"] = summary.total_s;
-  metrics["warnings"] = summary.warnings;
-  write_file_atomic(dir.path() / "metrics.json", metrics.dump(2) + "\n");
+  write_file_atomic(dir.path() / "metrics.json", summary.to_json().dump(2) + "\n");
   dir.commit();
   return summary;
 }

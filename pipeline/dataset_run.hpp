@@ -2,12 +2,16 @@
 // exported by driftlab), evaluated against its ground truth with the tables of `driftlab eval`.
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "dataset/dataset.hpp"
+#include "pipeline/run_record.hpp"
 #include "pipeline/scenario.hpp"
 
 namespace driftlab::pipeline {
@@ -23,12 +27,18 @@ struct DatasetRunOptions {
   bool progress_tty = false;
 };
 
+/// What `driftlab vo` measured: one typed record, written to metrics.json by to_json().
 struct DatasetRunSummary {
+  std::uint64_t seed = 0;
   std::size_t frames = 0;
   double total_s = 0;
+  nlohmann::json dataset;                       ///< the dataset: root, format, frames, rig
+  std::optional<nlohmann::json> filters_world;  ///< the filters' levelled world, when used
+  TrackRecords tracks;
   std::vector<std::string> algorithms;  ///< one brief line per estimate (VO or filter)
-  std::vector<std::string> warnings;    ///< also in metrics.json
+  std::vector<std::string> warnings;
   std::string brief() const;
+  nlohmann::json to_json() const;
 };
 
 /// Runs the VOs on `data` into `out_dir` (written atomically): estimates/NAME.tum,

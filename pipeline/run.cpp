@@ -70,8 +70,39 @@ std::string body_csv_row(const sim::BodySample& b) {
 std::string RunSummary::brief() const {
   std::string s = fmt::format("{}; {} camera frames, camera track {:.2f} m; physics {:.2f} s",
                               motion.brief(), frames, track_length_m, physics_s);
-  if (render_pairs_per_s > 0) s += fmt::format(", render {:.1f} pairs/s", render_pairs_per_s);
+  if (vision && vision->render_pairs_per_s > 0)
+    s += fmt::format(", render {:.1f} pairs/s", vision->render_pairs_per_s);
   return s + fmt::format(", total {:.2f} s", total_s);
+}
+
+nlohmann::json RunSummary::to_json() const {
+  nlohmann::json m;
+  m["version"] = DRIFTLAB_VERSION;
+  m["seed"] = seed;
+  m["scenario"] = scenario;
+  m["frames"] = frames;
+  m["track"]["length_m"] = track_length_m;
+  m["motion"] = {{"mission_completed", motion.mission_completed},
+                 {"duration_s", motion.duration_s},
+                 {"distance_m", motion.distance_m},
+                 {"mean_speed_m_s", motion.mean_speed_mps},
+                 {"physics_steps", motion.steps}};
+  m["stages"] = {{"scenario", stages.scenario},
+                 {"physics", stages.physics},
+                 {"sensors", stages.sensors},
+                 {"render", stages.render},
+                 {"vo", stages.vo},
+                 {"external_vo", stages.external_vo},
+                 {"fusion", stages.fusion},
+                 {"eval", stages.eval}};
+  m["sensors"] = sensors;
+  m["timing"]["sensors_s"] = sensors_s;
+  m["timing"]["physics_s"] = physics_s;
+  m["timing"]["total_s"] = total_s;
+  m["timing"]["physics_steps_per_s"] =
+      physics_s > 0 ? static_cast<double>(motion.steps) / physics_s : 0.0;
+  if (vision) vision->add_to(&m);
+  return m;
 }
 
 SE3 camera_mount_T_B_C(const sim::MountOptions& mount) {
@@ -172,13 +203,13 @@ cv::Mat draw_matches(const vo::StereoFrame& frame, std::span<const vo::MatchInfo
 // Where each VO lost track: metrics (algorithms.NAME.tracking), a warning for a stretch of a
 // second or more, and the report's table.
 std::string report_tracking(const std::vector<Track>& tracks, const Trajectory& camera_gt,
-                            nlohmann::json* metrics, std::vector<std::string>* warnings) {
+                            TrackRecords* records, std::vector<std::string>* warnings) {
   std::vector<std::string> names;
   std::vector<TrackingSummary> summaries;
   for (const Track& tr : tracks) {
     if (!tr.vo) continue;
     const TrackingSummary s = summarize_tracking(tr.results, camera_gt);
-    (*metrics)["algorithms"][tr.name]["tracking"] = s.to_json();
+    records->algorithms[tr.name].tracking = s.to_json();
     const std::string w = tracking_warning(tr.name, s);
     if (!w.empty()) warnings->push_back(w);
     names.push_back(tr.name);
@@ -221,7 +252,7 @@ std::vector<Track> make_tracks(const Scenario& sc, const StereoRig& rig,
 // VO's inliers and depths as the section covariates): metrics.json's algorithms and VO
 // timings, and the tables; each track's sections CSV is appended to *sections.
 std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks,
-                            const MissionTruth& mission, nlohmann::json* metrics,
+                            const MissionTruth& mission, TrackRecords* records,
                             std::string* sections_csv) {
   const Trajectory& camera_gt = mission.camera_gt;
   const std::vector<EulerZYX>& platform = mission.platform;
@@ -259,12 +290,13 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
     }
     in.frames = ft;
     const eval::Evaluation e = eval::evaluate(in);
-    (*metrics)["algorithms"][tr.name] = eval::to_json(e, sc.eval);
+    records->algorithms[tr.name].evaluation = eval::to_json(e, sc.eval);
     report += eval::tables_markdown(e, sc.eval) + "\n";
     const std::string csv = eval::sections_csv(e);
     sections += sections.empty() ? csv : csv.substr(csv.find('\n') + 1);
     if (tr.vo)
-      add_vo_timing(*tr.vo, tr.name, tr.vo_ms / static_cast<double>(camera_gt.size()), metrics);
+      records->vo_timing[tr.name] =
+          vo_timing(*tr.vo, tr.vo_ms / static_cast<double>(camera_gt.size()));
   }
   return report;
 }
@@ -273,7 +305,8 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
 // the tables so far (`report`).
 void write_report(const Scenario& sc, const std::vector<Track>& tracks, const Trajectory& camera_gt,
                   const std::filesystem::path& dir, std::size_t sample_frame,
-                  const std::string& sections, std::string report, const nlohmann::json& metrics,
+                  const std::string& sections, std::string report,
+                  const std::map<std::string, nlohmann::json>& external_vo,
                   std::vector<std::string>* warnings) {
   std::vector<report::NamedTrajectory> named;
   for (const auto& tr : tracks) named.push_back({tr.name, tr.estimate});
@@ -287,10 +320,10 @@ void write_report(const Scenario& sc, const std::vector<Track>& tracks, const Tr
                                    "from the previous frame in orange (Fig. 3)",
                                    sample_frame, tr.name),
                        "plots/" + tr.name + "_matches.png"});
-  if (metrics.contains("external_vo")) {  // every external VO's fate, failures included
+  if (!external_vo.empty()) {  // every external VO's fate, failures included
     report +=
         "## External VOs\n\n| name | status | exit | seconds | message |\n|---|---|---|---|---|\n";
-    for (const auto& [name, r] : metrics["external_vo"].items())
+    for (const auto& [name, r] : external_vo)
       report += fmt::format("| {} | {} | {} | {:.2f} | {} |\n", name,
                             r["status"].get<std::string>(), r["exit"].get<std::string>(),
                             r["seconds"].get<double>(), r["message"].get<std::string>());
@@ -317,29 +350,41 @@ sim::SceneGeometry scene_for_track(const Scenario& sc, const Trajectory& camera_
 
 namespace {
 
+// What the frame loop reads and where it writes.
+struct FrameLoop {
+  FrameSource& source;                         // the frames, rendered or replayed
+  const std::vector<sim::SampleTime>& stamps;  // the camera clock's stamps and drops
+  const MissionTruth& mission;
+  std::size_t first;                 // the first frame the camera delivers
+  const std::filesystem::path& dir;  // the run's folder: frames.csv, plots/
+  const RunOptions& options;
+  int threads;
+  ExternalVoStage& external;  // the exports for the external VOs
+  std::vector<Track>& tracks;
+};
+
 // The frame loop: every delivered frame through every track (the VOs, side by side when
 // `threads` >= 2, then the filters following them), a frames.csv row each, the exports for
 // the external VOs. Returns the render seconds.
-double run_frame_loop(FrameSource& source, const std::vector<sim::SampleTime>& stamps,
-                      const MissionTruth& mission, std::size_t first,
-                      const std::filesystem::path& dir, const RunOptions& options, int threads,
-                      ExternalVoStage* external, std::vector<Track>* tracks_io) {
-  std::vector<Track>& tracks = *tracks_io;
-  const Trajectory& camera_gt = mission.camera_gt;
-  const std::vector<EulerZYX>& platform = mission.platform;
+double run_frame_loop(const FrameLoop& loop) {
+  std::vector<Track>& tracks = loop.tracks;
+  const std::filesystem::path& dir = loop.dir;
+  const Trajectory& camera_gt = loop.mission.camera_gt;
+  const std::vector<EulerZYX>& platform = loop.mission.platform;
   AtomicFile frames_csv(dir / "frames.csv");
   std::string header = "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms,exposure_ms,blur_samples";
   for (const Track& tr : tracks)
     if (tr.vo) header += vo_csv_header(tr.name);
   frames_csv.write(header + "\n");
   double render_s = 0;
-  Progress progress(options.progress, "render+vo", camera_gt.size(), options.progress_tty);
+  Progress progress(loop.options.progress, "render+vo", camera_gt.size(),
+                    loop.options.progress_tty);
   const std::size_t sample_frame = camera_gt.size() / 2;  // drawn with its matches (Fig. 3)
   std::filesystem::create_directories(dir / "plots");
-  while (std::optional<CapturedFrame> captured = source.next()) {
+  while (std::optional<CapturedFrame> captured = loop.source.next()) {
     const std::size_t k = captured->k;  // dropped frames never come: nothing rendered or seen
     progress.update(k);
-    const TimeNs t = stamps[k].t_stamp_ns;  // what the camera's clock wrote
+    const TimeNs t = loop.stamps[k].t_stamp_ns;  // what the camera's clock wrote
     const double render_ms = captured->render_ms;
     const double exposure_ms = captured->exposure_ms;
     render_s += render_ms / 1000;
@@ -352,7 +397,7 @@ double run_frame_loop(FrameSource& source, const std::vector<sim::SampleTime>& s
         fmt::format("{},{},{},{},{:.3f},{},{}", t, rad2deg(platform[k].yaw_rad),
                     rad2deg(platform[k].pitch_rad), rad2deg(platform[k].roll_rad), render_ms,
                     yaml::format_double(exposure_ms), captured->blur_samples);
-    const std::vector<vo::VoResult> vo_results = process_vos(&tracks, frame, threads);
+    const std::vector<vo::VoResult> vo_results = process_vos(&tracks, frame, loop.threads);
     for (std::size_t i = 0; i < tracks.size(); ++i) {
       Track& tr = tracks[i];
       const vo::VoResult& r = tr.vo ? vo_results[i] : tracks[tr.source].results[k];
@@ -360,10 +405,10 @@ double run_frame_loop(FrameSource& source, const std::vector<sim::SampleTime>& s
         cv::imwrite((dir / "plots" / (tr.name + "_matches.png")).string(),
                     draw_matches(frame, tr.vo->last_matches()));
       if (tr.vo) row += vo_csv_cells(r);
-      advance_track(&tr, k, k == first, t, r);
+      advance_track(&tr, k, k == loop.first, t, r);
     }
     frames_csv.write(row + "\n");
-    external->add_frame(t, img, camera_gt[k]);
+    loop.external.add_frame(t, img, camera_gt[k]);
   }
   progress.update(camera_gt.size());
   progress.finish();
@@ -375,7 +420,8 @@ double run_frame_loop(FrameSource& source, const std::vector<sim::SampleTime>& s
 // whole run (NAME_ca_rts) and the external VOs, run on the exports of the same frames.
 void add_whole_run_tracks(const Scenario& sc, const std::vector<sim::SampleTime>& stamps,
                           std::size_t first, const MissionTruth& mission, ExternalVoStage* external,
-                          std::vector<Track>* tracks, nlohmann::json* metrics,
+                          std::vector<Track>* tracks,
+                          std::map<std::string, nlohmann::json>* external_vo,
                           std::vector<std::string>* warnings) {
   if (runs_backward_pass(sc.pipeline)) {
     std::vector<std::optional<TimeNs>> delivered(stamps.size());
@@ -385,7 +431,7 @@ void add_whole_run_tracks(const Scenario& sc, const std::vector<sim::SampleTime>
       tracks->push_back(rts_smoothed((*tracks)[i], i, delivered, sc.pipeline.ca_smoother));
   }
   for (ExternalVoResult& r : external->finish(mission.imu_states)) {
-    (*metrics)["external_vo"][r.name] = r.record;
+    (*external_vo)[r.name] = r.record;
     if (!r.warning.empty()) warnings->push_back(r.warning);
     if (!r.ok) continue;
     Track t;
@@ -398,39 +444,43 @@ void add_whole_run_tracks(const Scenario& sc, const std::vector<sim::SampleTime>
   }
 }
 
-// metrics.json's camera block: frames delivered and dropped, and the effects that were on.
-nlohmann::json camera_metrics(const Scenario& sc, std::size_t frames, std::size_t dropped) {
+// The camera as the run saw it: frames delivered and dropped, and the effects that were on.
+CameraRecord camera_record(const Scenario& sc, std::size_t frames, std::size_t dropped) {
   const auto& cam = sc.sensors.camera;
-  return {{"frames_delivered", frames - dropped},
-          {"frames_dropped", dropped},
-          {"noise", cam.noise.enabled},
-          {"vignetting_strength", cam.vignetting_strength},
-          {"motion_blur_samples", sc.render.motion_blur_samples},
-          {"motion_blur_step_px", sc.render.motion_blur_step_px},
-          {"lens_distortion", cam.lens_distortion.enabled},
-          {"clock_offset_ms", cam.clock.offset_ms}};
+  CameraRecord c;
+  c.frames_delivered = frames - dropped;
+  c.frames_dropped = dropped;
+  c.noise = cam.noise.enabled;
+  c.vignetting_strength = cam.vignetting_strength;
+  c.motion_blur_samples = sc.render.motion_blur_samples;
+  c.motion_blur_step_px = sc.render.motion_blur_step_px;
+  c.lens_distortion = cam.lens_distortion.enabled;
+  c.clock_offset_ms = cam.clock.offset_ms;
+  return c;
 }
 
 }  // namespace
 
-static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scene,
-                              const SensorData& sensor_data, const MissionTruth& mission,
-                              const std::filesystem::path& dir,
-                              const std::filesystem::path& final_dir, const RunOptions& options,
-                              RunSummary* summary, nlohmann::json* metrics) {
+// The render, VO, fusion and evaluation stages: their estimates, frames.csv, sections.csv
+// and the report in `dir`, their record returned.
+static VisionRecord run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scene,
+                                      const SensorData& sensor_data, const MissionTruth& mission,
+                                      const std::filesystem::path& dir,
+                                      const std::filesystem::path& final_dir,
+                                      const RunOptions& options) {
   const Trajectory& camera_gt = mission.camera_gt;
   const RngStreams rng(sc.seed);
+  VisionRecord record;
   // The camera's clock: stamps (offset, jitter) and dropped frames.
   const std::vector<sim::SampleTime> stamps =
       sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
   DRIFTLAB_DEMAND_MSG(stamps.size() >= camera_gt.size(), "camera clock: fewer stamps than frames");
   // Stage: render and camera effects (the scene built once, uploaded once), on a thread of
   // their own when the run has more than one.
-  const int threads = run_threads(sc.pipeline.threads);
+  record.threads = run_threads(sc.pipeline.threads);
   ExternalVoStage external(sc, dir, final_dir);  // exports of the frames for the external VOs
-  FrameSource source(sc, scene, mission.frames, stamps, threads, 4, external.wants_depth(),
+  FrameSource source(sc, scene, mission.frames, stamps, record.threads, 4, external.wants_depth(),
                      options.frame_cache);
-  (*metrics)["timing"]["threads"] = threads;
 
   // Stages: VO and fusion. VO sees images and the rig only; the pipeline
   // anchors every estimate at the true first pose so that tracks overlay.
@@ -439,43 +489,41 @@ static void run_vision_stages(const Scenario& sc, const sim::SceneGeometry& scen
   const SE3 T_W_C0 = first < camera_gt.size() ? camera_gt[first].T_W_C : SE3();
   std::vector<Track> tracks =
       make_tracks(sc, rig_of(sc.sensors.camera), sensor_data, camera_gt, T_W_C0, rng);
-  std::vector<std::string> warnings = implausible_values(sc);
+  std::vector<std::string>& warnings = record.warnings;
+  warnings = implausible_values(sc);
   if (first < camera_gt.size())
     for (auto& t : tracks) t.estimate.push_back({stamps[first].t_stamp_ns, camera_gt[first].T_W_C});
   std::size_t dropped = 0;
   for (std::size_t k = 0; k < camera_gt.size(); ++k) dropped += stamps[k].dropped ? 1 : 0;
-  const double render_s =
-      run_frame_loop(source, stamps, mission, first, dir, options, threads, &external, &tracks);
-  add_whole_run_tracks(sc, stamps, first, mission, &external, &tracks, metrics, &warnings);
+  record.render_s = run_frame_loop(
+      {source, stamps, mission, first, dir, options, record.threads, external, tracks});
+  add_whole_run_tracks(sc, stamps, first, mission, &external, &tracks, &record.external_vo,
+                       &warnings);
   write_estimates(tracks, dir);
 
   // Stage: evaluation of every estimate against the camera ground truth.
   std::string report = fmt::format("# driftlab run: {}\n\n{}\n\n", sc.name, sc.description);
   std::string sections;
-  report += evaluate_tracks(sc, tracks, mission, metrics, &sections);
+  report += evaluate_tracks(sc, tracks, mission, &record.tracks, &sections);
   write_file_atomic(dir / "sections.csv", sections);
-  report += report_tracking(tracks, camera_gt, metrics, &warnings);
-  report += compare_filters_with_raw_vo(tracks, metrics, &warnings);
-  report_filter_counts(tracks, metrics, &warnings);
+  report += report_tracking(tracks, camera_gt, &record.tracks, &warnings);
+  report += compare_filters_with_raw_vo(tracks, &record.tracks, &warnings);
+  report_filter_counts(tracks, &record.tracks, &warnings);
 
-  write_report(sc, tracks, camera_gt, dir, camera_gt.size() / 2, sections, report, *metrics,
-               &warnings);
-  (*metrics)["timing"]["render_s"] = render_s;
-  (*metrics)["timing"]["render_pairs_per_s"] =
-      render_s > 0 ? static_cast<double>(camera_gt.size() - dropped) / render_s : 0.0;
-  (*metrics)["camera"] = camera_metrics(sc, camera_gt.size(), dropped);
-  const FrameCacheStatus cache = source.cache_status();
-  (*metrics)["frame_cache"] = {
-      {"state", cache.state}, {"entry", cache.entry}, {"note", cache.note}};
-  if (cache.warn) {
-    warnings.push_back(cache.note);
-    if (options.progress) fmt::print(options.progress, "warning: {}\n", cache.note);
+  write_report(sc, tracks, camera_gt, dir, camera_gt.size() / 2, sections, report,
+               record.external_vo, &warnings);
+  record.render_pairs_per_s =
+      record.render_s > 0 ? static_cast<double>(camera_gt.size() - dropped) / record.render_s : 0.0;
+  record.camera = camera_record(sc, camera_gt.size(), dropped);
+  record.frame_cache = source.cache_status();
+  if (record.frame_cache.warn) {
+    warnings.push_back(record.frame_cache.note);
+    if (options.progress) fmt::print(options.progress, "warning: {}\n", record.frame_cache.note);
   }
-  (*metrics)["warnings"] = warnings;
-  (*metrics)["render"] = {{"context", source.info().context},
-                          {"assets", scenes::shipped_asset_dir()},
-                          {"triangles", source.info().triangles}};
-  summary->render_pairs_per_s = (*metrics)["timing"]["render_pairs_per_s"];
+  record.render_context = source.info().context;
+  record.assets = scenes::shipped_asset_dir();
+  record.triangles = source.info().triangles;
+  return record;
 }
 
 SE3 imu_mount_T_B_S(const Scenario& sc) {
@@ -516,9 +564,8 @@ MissionTruth simulate_mission(const Scenario& sc,
   return truth;
 }
 
-// What each stage did, with the reason when it did not run (metrics.json "stages").
-static nlohmann::json stages_record(const Scenario& sc, const RunOptions& options,
-                                    bool ran_vision) {
+// What each stage did, with the reason when it did not run.
+static StageRecord stages_record(const Scenario& sc, const RunOptions& options, bool ran_vision) {
   const auto& s = sc.sensors;
   const std::string vision = ran_vision            ? "done"
                              : options.only_motion ? "skipped (--only-motion)"
@@ -527,16 +574,18 @@ static nlohmann::json stages_record(const Scenario& sc, const RunOptions& option
   const auto unless = [&](bool empty, const char* why) {
     return vision != "done" ? vision : empty ? std::string("skipped (") + why + ")" : vision;
   };
-  return {{"scenario", "done"},
-          {"physics", "done"},
-          {"sensors", s.imu.enabled || s.gps.enabled || s.compass.enabled
-                          ? "done"
-                          : "skipped (no IMU, GPS or compass enabled)"},
-          {"render", vision},
-          {"vo", unless(sc.pipeline.vo.empty(), "pipeline.vo is empty")},
-          {"external_vo", unless(sc.pipeline.external_vo.empty(), "pipeline.external_vo is empty")},
-          {"fusion", unless(sc.pipeline.fusion.empty(), "pipeline.fusion is empty")},
-          {"eval", vision}};
+  StageRecord r;
+  r.scenario = "done";
+  r.physics = "done";
+  r.sensors = s.imu.enabled || s.gps.enabled || s.compass.enabled
+                  ? "done"
+                  : "skipped (no IMU, GPS or compass enabled)";
+  r.render = vision;
+  r.vo = unless(sc.pipeline.vo.empty(), "pipeline.vo is empty");
+  r.external_vo = unless(sc.pipeline.external_vo.empty(), "pipeline.external_vo is empty");
+  r.fusion = unless(sc.pipeline.fusion.empty(), "pipeline.fusion is empty");
+  r.eval = vision;
+  return r;
 }
 
 RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir,
@@ -567,39 +616,26 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
     summary.track_length_m +=
         (camera_gt[i].T_W_C.translation() - camera_gt[i - 1].T_W_C.translation()).norm();
 
-  nlohmann::json metrics;
   // Stage: sensors. GPS and compass need the scene (sky obstruction, steel structures).
   const auto t_sensors = SteadyClock::now();
   std::optional<sim::SceneGeometry> scene;
   if (!camera_gt.empty()) scene = scene_for_track(sc, camera_gt);
   const SensorData sensor_data = sensors.finish(scene ? &*scene : nullptr);
-  metrics["sensors"] = sensor_data.stats;
-  metrics["timing"]["sensors_s"] = seconds_since(t_sensors);
+  summary.sensors = sensor_data.stats;
+  summary.sensors_s = seconds_since(t_sensors);
 
   const bool run_vo = !options.only_motion &&
                       (!sc.pipeline.vo.empty() || !sc.pipeline.external_vo.empty()) &&
                       !camera_gt.empty();
   if (run_vo)
-    run_vision_stages(sc, *scene, sensor_data, truth, dir.path(), dir.final_path(), options,
-                      &summary, &metrics);
+    summary.vision =
+        run_vision_stages(sc, *scene, sensor_data, truth, dir.path(), dir.final_path(), options);
 
+  summary.scenario = sc.name;
+  summary.seed = sc.seed;
+  summary.stages = stages_record(sc, options, run_vo);
   summary.total_s = seconds_since(t0);
-  metrics["version"] = DRIFTLAB_VERSION;
-  metrics["seed"] = sc.seed;
-  metrics["scenario"] = sc.name;
-  metrics["frames"] = summary.frames;
-  metrics["track"]["length_m"] = summary.track_length_m;
-  metrics["motion"] = {{"mission_completed", summary.motion.mission_completed},
-                       {"duration_s", summary.motion.duration_s},
-                       {"distance_m", summary.motion.distance_m},
-                       {"mean_speed_m_s", summary.motion.mean_speed_mps},
-                       {"physics_steps", summary.motion.steps}};
-  metrics["stages"] = stages_record(sc, options, run_vo);
-  metrics["timing"]["physics_s"] = summary.physics_s;
-  metrics["timing"]["total_s"] = summary.total_s;
-  metrics["timing"]["physics_steps_per_s"] =
-      summary.physics_s > 0 ? static_cast<double>(summary.motion.steps) / summary.physics_s : 0.0;
-  write_file_atomic(dir.path() / "metrics.json", metrics.dump(2) + "\n");
+  write_file_atomic(dir.path() / "metrics.json", summary.to_json().dump(2) + "\n");
   dir.commit();
   return summary;
 }

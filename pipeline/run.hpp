@@ -4,9 +4,11 @@
 // and evaluation with their issues.
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include "dataset/dataset.hpp"
 #include "pipeline/camera_stage.hpp"
 #include "pipeline/frame_cache.hpp"
+#include "pipeline/run_record.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/sensor_stage.hpp"
 #include "sim/render/scene_geometry.hpp"
@@ -31,14 +34,23 @@ struct RunOptions {
   FrameCacheOptions frame_cache;  // where frames are kept and replayed (no folder: nowhere)
 };
 
+/// What a scenario run measured, as Ceres' Solver::Summary: one typed record its stages fill,
+/// written to metrics.json by to_json() and summed up in a line by brief().
 struct RunSummary {
+  std::string scenario;
+  std::uint64_t seed = 0;
   sim::MotionSummary motion;
-  std::size_t frames = 0;         // camera frames with ground truth
-  double track_length_m = 0;      // camera-left path length
-  double physics_s = 0;           // wall-clock time of the physics stage
-  double render_pairs_per_s = 0;  // 0 when the render stage did not run
+  std::size_t frames = 0;     ///< camera frames with ground truth
+  double track_length_m = 0;  ///< camera-left path length
+  StageRecord stages;
+  nlohmann::json sensors;  ///< per sensor: samples, the GPS's sky statistics (SensorData::stats)
+  double physics_s = 0;    ///< wall-clock time of the physics stage
+  double sensors_s = 0;    ///< of the sensor stage
   double total_s = 0;
+  std::optional<VisionRecord> vision;  ///< render, VO, fusion, evaluation (when they ran)
   std::string brief() const;
+  /// metrics.json (docs/design.md, "Data contract of a run").
+  nlohmann::json to_json() const;
 };
 
 /// Pose of the left camera (optical frame) in the body (FRD) frame, from the

@@ -115,12 +115,12 @@ void write_estimates(const std::vector<Track>& tracks, const std::filesystem::pa
   }
 }
 
-void report_filter_counts(const std::vector<Track>& tracks, nlohmann::json* metrics,
+void report_filter_counts(const std::vector<Track>& tracks, TrackRecords* records,
                           std::vector<std::string>* warnings) {
   for (const Track& tr : tracks) {
     if (!tr.filter) continue;
     const FilterCounts c = tr.filter->counts();
-    (*metrics)["algorithms"][tr.name]["filter"] = c.counts;
+    records->algorithms[tr.name].filter = nlohmann::json(c.counts);
     if (c.nonfinite_guards > 0)
       warnings->push_back(fmt::format(
           "{}: {} non-finite inputs or states were caught (skipped, or the filter restarted); "
@@ -129,30 +129,26 @@ void report_filter_counts(const std::vector<Track>& tracks, nlohmann::json* metr
   }
 }
 
-std::string compare_filters_with_raw_vo(const std::vector<Track>& tracks, nlohmann::json* metrics,
+std::string compare_filters_with_raw_vo(const std::vector<Track>& tracks, TrackRecords* records,
                                         std::vector<std::string>* warnings) {
   std::string table;
   for (const Track& tr : tracks) {
     if (tr.vo || tr.external) continue;
     const std::string& raw = tracks[tr.source].name;
-    auto& algorithms = (*metrics)["algorithms"];
-    const auto& f = algorithms[tr.name]["ape"]["trans_m"]["rmse"];
-    const auto& r = algorithms[raw]["ape"]["trans_m"]["rmse"];
-    if (!f.is_number() || !r.is_number()) continue;  // no associated poses
-    const double filtered_m = f.get<double>(), raw_m = r.get<double>();
-    const bool better = filtered_m < raw_m;
-    algorithms[tr.name]["vs_raw_vo"] = {{"raw_vo", raw},
-                                        {"metric", "ape.trans_m.rmse"},
-                                        {"filtered", filtered_m},
-                                        {"raw", raw_m},
-                                        {"ratio", raw_m > 0 ? filtered_m / raw_m : 0.0},
-                                        {"better", better}};
-    if (!better)
+    const auto filtered = records->algorithms.find(tr.name);
+    const auto unfiltered = records->algorithms.find(raw);
+    if (filtered == records->algorithms.end() || unfiltered == records->algorithms.end()) continue;
+    const std::optional<double> f = filtered->second.ape_trans_rmse_m();
+    const std::optional<double> r = unfiltered->second.ape_trans_rmse_m();
+    if (!f || !r) continue;  // no associated poses
+    const VsRawVo v{raw, *f, *r};
+    filtered->second.vs_raw_vo = v;
+    if (!v.better())
       warnings->push_back(fmt::format(
           "{} is no better than its raw VO {}: APE translation RMSE {:.4g} m against {:.4g} m",
-          tr.name, raw, filtered_m, raw_m));
-    table += fmt::format("| {} | {} | {:.4g} | {:.4g} | {:.2f} | {} |\n", tr.name, raw, filtered_m,
-                         raw_m, raw_m > 0 ? filtered_m / raw_m : 0.0, better ? "yes" : "**no**");
+          tr.name, raw, v.filtered, v.raw));
+    table += fmt::format("| {} | {} | {:.4g} | {:.4g} | {:.2f} | {} |\n", tr.name, raw, v.filtered,
+                         v.raw, v.ratio(), v.better() ? "yes" : "**no**");
   }
   if (table.empty()) return "";
   return "## Filters against their raw VO\n\n| filter | raw VO | APE trans. RMSE (m) | raw VO's "

@@ -18,6 +18,7 @@
 #include "core/trajectory_io.hpp"
 #include "fusion/ca_smoother.hpp"
 #include "pipeline/filter_stage.hpp"
+#include "pipeline/run_record.hpp"
 #include "pipeline/scenario.hpp"
 #include "vo/stereo_odometry.hpp"
 
@@ -73,13 +74,13 @@ void write_estimates(const std::vector<Track>& tracks, const std::filesystem::pa
 
 /// What each filter and smoother did (algorithms.NAME.filter: measurements fused, skipped,
 /// gated; non-finite guards), and a warning for every guard that fired.
-void report_filter_counts(const std::vector<Track>& tracks, nlohmann::json* metrics,
+void report_filter_counts(const std::vector<Track>& tracks, TrackRecords* records,
                           std::vector<std::string>* warnings);
 
 /// Each filter's estimate against its raw VO's, by APE translation RMSE (the same evaluation,
 /// the same frames): `vs_raw_vo` in the filter's metrics, a report table, and a warning for each
 /// filter that is worse than the VO it filters, so that a filter that does not help says so.
-std::string compare_filters_with_raw_vo(const std::vector<Track>& tracks, nlohmann::json* metrics,
+std::string compare_filters_with_raw_vo(const std::vector<Track>& tracks, TrackRecords* records,
                                         std::vector<std::string>* warnings);
 
 }  // namespace driftlab::pipeline

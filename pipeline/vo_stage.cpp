@@ -49,14 +49,14 @@ std::vector<std::unique_ptr<vo::StereoOdometry>> make_vos(const std::vector<std:
   return vos;
 }
 
-void add_vo_timing(const vo::StereoOdometry& vo, const std::string& name, double ms_per_frame,
-                   nlohmann::json* metrics) {
-  (*metrics)["timing"]["vo_ms_per_frame"][name] = ms_per_frame;
+VoTiming vo_timing(const vo::StereoOdometry& vo, double ms_per_frame) {
+  VoTiming t;
+  t.ms_per_frame = ms_per_frame;
   if (const auto* sparse = dynamic_cast<const vo::SparseStereoOdometry*>(&vo)) {
     const auto counts = sparse->detection_counts();
-    (*metrics)["timing"]["sparse_pairs"][name] = {{"detected", counts.detected},
-                                                  {"shared", counts.shared}};
+    t.sparse_pairs = VoTiming::SparsePairs{counts.detected, counts.shared};
   }
+  return t;
 }
 
 std::string vo_csv_header(const std::string& name) {

@@ -10,6 +10,7 @@
 
 #include "core/camera.hpp"
 #include "core/rng.hpp"
+#include "pipeline/run_record.hpp"
 #include "pipeline/scenario.hpp"
 #include "vo/stereo_odometry.hpp"
 
@@ -25,12 +26,11 @@ std::vector<std::unique_ptr<vo::StereoOdometry>> make_vos(const std::vector<std:
                                                           const PipelineOptions& pipeline,
                                                           const RngStreams& rng);
 
-/// metrics.json's timing of one VO: timing.vo_ms_per_frame.NAME and, for a sparse VO,
-/// timing.sparse_pairs.NAME = {"detected": n, "shared": m}, the pairs it detected itself and
-/// those it took from the VO it shares detection with (which of the two detects a pair depends
-/// on the threads' timing; the two add up to the frames it processed).
-void add_vo_timing(const vo::StereoOdometry& vo, const std::string& name, double ms_per_frame,
-                   nlohmann::json* metrics);
+/// The cost of one VO (metrics.json timing.vo_ms_per_frame.NAME) and, for a sparse VO, the
+/// pairs it detected itself and those it took from the VO it shares detection with
+/// (timing.sparse_pairs.NAME; which of the two detects a pair depends on the threads' timing;
+/// the two add up to the frames it processed).
+VoTiming vo_timing(const vo::StereoOdometry& vo, double ms_per_frame);
 
 /// frames.csv columns of one VO: ",NAME_valid,NAME_inliers,NAME_valid_depth_px,
 /// NAME_mean_depth_m,NAME_ref_frames,NAME_features,NAME_lost,NAME_ms". `_features` is the
