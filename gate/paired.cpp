@@ -2,6 +2,7 @@
 
 #include <boost/math/distributions/normal.hpp>
 #include <boost/math/distributions/students_t.hpp>
+#include <tuple>
 
 #include <algorithm>
 #include <cmath>
@@ -81,6 +82,13 @@ SignedRankTest wilcoxon_signed_rank(const std::vector<double>& d) {
   return t;
 }
 
+std::pair<double, double> confidence_interval_95(double mean, double sd, std::size_t n) {
+  if (n < 2) return {mean, mean};
+  const boost::math::students_t t(static_cast<double>(n - 1));
+  const double half = boost::math::quantile(t, 0.975) * sd / std::sqrt(static_cast<double>(n));
+  return {mean - half, mean + half};
+}
+
 PairedChange paired_change(const std::vector<double>& a, const std::vector<double>& b) {
   DRIFTLAB_DEMAND_MSG(a.size() == b.size(), "paired_change: sides of different sizes");
   PairedChange c;
@@ -100,10 +108,7 @@ PairedChange paired_change(const std::vector<double>& a, const std::vector<doubl
   if (c.n >= 2) {
     double ss = 0;
     for (const double x : d) ss += (x - c.diff) * (x - c.diff);
-    const boost::math::students_t t(n - 1);
-    const double half = boost::math::quantile(t, 0.975) * std::sqrt(ss / (n - 1) / n);
-    c.diff_lo = c.diff - half;
-    c.diff_hi = c.diff + half;
+    std::tie(c.diff_lo, c.diff_hi) = confidence_interval_95(c.diff, std::sqrt(ss / (n - 1)), c.n);
   }
   if (c.mean_a != 0) {
     const double s = std::abs(c.mean_a);

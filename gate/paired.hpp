@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 namespace driftlab::gate {
@@ -38,6 +39,12 @@ struct PairedChange {
   double rel = 0, rel_lo = 0, rel_hi = 0;     ///< the same over |mean_a| (0 when mean_a is 0)
   SignedRankTest test;
 };
+
+/// Two-sided 95% confidence interval of a mean from n samples with sample
+/// standard deviation sd (Student's t with n - 1 degrees of freedom);
+/// {mean, mean} when n < 2. The gate's paired differences and the sweep
+/// merge's replicate means both use it.
+std::pair<double, double> confidence_interval_95(double mean, double sd, std::size_t n);
 
 /// Compares b against a, pair by pair (a[i] with b[i]; equal sizes).
 PairedChange paired_change(const std::vector<double>& a, const std::vector<double>& b);

@@ -4,7 +4,6 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -54,13 +53,6 @@ const std::vector<RunMetric>& run_metrics() {
       {"filter_nonfinite_guards", "filter.nonfinite_guards", "filter's non-finite guards"},
   };
   return metrics;
-}
-
-std::pair<double, double> confidence_interval_95(double mean, double sd, std::size_t n) {
-  if (n < 2) return {mean, mean};
-  const boost::math::students_t t(static_cast<double>(n - 1));
-  const double half = boost::math::quantile(t, 0.975) * sd / std::sqrt(static_cast<double>(n));
-  return {mean - half, mean + half};
 }
 
 namespace {
@@ -122,7 +114,7 @@ Stat stat_of(const std::vector<double>& values) {
   s.mean = sum.mean;
   if (s.n >= 2) {
     s.sd = sum.sd_sample;
-    std::tie(s.lo, s.hi) = confidence_interval_95(s.mean, s.sd, s.n);
+    std::tie(s.lo, s.hi) = gate::confidence_interval_95(s.mean, s.sd, s.n);
   }
   return s;
 }

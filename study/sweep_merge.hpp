@@ -73,9 +73,4 @@ const std::vector<RunMetric>& run_metrics();
 double run_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
                         const RunMetric& metric);
 
-/// Two-sided 95% confidence interval of a mean from n samples with sample
-/// standard deviation sd (Student's t with n - 1 degrees of freedom);
-/// {mean, mean} when n < 2.
-std::pair<double, double> confidence_interval_95(double mean, double sd, std::size_t n);
-
 }  // namespace driftlab::study

@@ -497,19 +497,6 @@ TEST(SweepMerge, RunMetricsIncludeTheBasinTableAndFilterStatisticsAndMissingIsMi
   EXPECT_TRUE(std::isnan(run_metric_value(run, "pnp_ned_kf", metric("lost_fraction"))));
 }
 
-TEST(SweepMerge, ConfidenceIntervalUsesStudentsT) {
-  // t quantiles 0.975 with 1 and 4 degrees of freedom: 12.706204736174698, 2.7764451051977934.
-  auto [lo2, hi2] = confidence_interval_95(10.0, 1.0, 2);
-  EXPECT_NEAR(hi2 - 10.0, 12.706204736174698 / std::sqrt(2.0), 1e-9);
-  EXPECT_NEAR(10.0 - lo2, 12.706204736174698 / std::sqrt(2.0), 1e-9);
-  auto [lo5, hi5] = confidence_interval_95(0.0, 2.0, 5);
-  EXPECT_NEAR(hi5, 2.7764451051977934 * 2.0 / std::sqrt(5.0), 1e-9);
-  EXPECT_NEAR(lo5, -hi5, 1e-12);
-  auto [lo1, hi1] = confidence_interval_95(3.0, 0.0, 1);
-  EXPECT_EQ(lo1, 3.0);
-  EXPECT_EQ(hi1, 3.0);
-}
-
 // ---------------------------------------------------------------------------
 // Through the CLI: runs, resume, merge.
 
