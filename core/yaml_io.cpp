@@ -536,15 +536,17 @@ std::string Validator::path(std::string_view key) const {
 
 void Validator::check_double(const std::string& key_path, double v, const Check& check) {
   if (!std::isfinite(v)) {
-    errors_->add(fmt::format("{}: got {}, expected a finite number", key_path, format_double(v)));
+    errors_->add_at(
+        key_path, fmt::format("{}: got {}, expected a finite number", key_path, format_double(v)));
     return;
   }
   if (const std::string expected = check.out_of_range(v); !expected.empty())
-    errors_->add(fmt::format("{}: got {}, expected {}", key_path, format_double(v), expected));
+    errors_->add_at(key_path,
+                    fmt::format("{}: got {}, expected {}", key_path, format_double(v), expected));
 }
 
 void Validator::require(bool ok, const char* key, std::string_view expected) {
-  if (!ok) errors_->add(fmt::format("{}: expected {}", path(key), expected));
+  if (!ok) errors_->add_at(path(key), fmt::format("{}: expected {}", path(key), expected));
 }
 
 // ---------------------------------------------------------------------------

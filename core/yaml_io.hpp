@@ -246,17 +246,32 @@ struct Source {
   bool is_file = true;
 };
 
+/// One problem: the key path it is about ("mission.waypoints_ne_m[3]"; empty when it names
+/// none, or when the message already says where in a file) and the message, which starts
+/// with it.
+struct Problem {
+  std::string path;
+  std::string message;
+};
+
 /// Collects every problem found while reading, then throws them together.
 class ErrorList {
  public:
-  void add(std::string message) { messages_.push_back(std::move(message)); }
+  void add(std::string message) { add_at({}, std::move(message)); }
+  /// A problem about the key at `path`.
+  void add_at(std::string path, std::string message) {
+    messages_.push_back(message);
+    problems_.push_back({std::move(path), std::move(message)});
+  }
   bool empty() const { return messages_.empty(); }
   const std::vector<std::string>& messages() const { return messages_; }
+  const std::vector<Problem>& problems() const { return problems_; }
   /// Throws UserError with all messages (one per line) if any were added.
   void throw_if_any(std::string_view header = {}) const;
 
  private:
   std::vector<std::string> messages_;
+  std::vector<Problem> problems_;
 };
 
 /// Reads a YAML map onto a visitable struct. Keys absent in the document keep
@@ -689,16 +704,16 @@ void Validator::check_value(const std::string& key_path, const T& value, const C
     check_double(key_path, static_cast<double>(value), check);
   } else if constexpr (std::is_same_v<T, std::string>) {
     if (check.non_empty_string && value.empty())
-      errors_->add(key_path + ": got an empty string, expected a non-empty string");
+      errors_->add_at(key_path, key_path + ": got an empty string, expected a non-empty string");
     else if (const std::string expected = unknown_choice(check, value); !expected.empty())
-      errors_->add(key_path + ": got '" + value + "', expected " + expected);
+      errors_->add_at(key_path, key_path + ": got '" + value + "', expected " + expected);
     else if (const std::string rule = check.text_rule ? check.text_rule(value) : ""; !rule.empty())
-      errors_->add(key_path + ": got '" + value + "', expected " + rule);
+      errors_->add_at(key_path, key_path + ": got '" + value + "', expected " + rule);
   } else if constexpr (is_std_vector<T>::value || is_std_array<T>::value) {
     if (value.size() < check.min_size || value.size() > check.max_size) {
       Check size_only{.min_size = check.min_size, .max_size = check.max_size};
-      errors_->add(key_path + ": got a list of " + std::to_string(value.size()) +
-                   ", expected a list of " + size_only.describe() + " entries");
+      errors_->add_at(key_path, key_path + ": got a list of " + std::to_string(value.size()) +
+                                    ", expected a list of " + size_only.describe() + " entries");
     }
     Check element_check = check;
     element_check.min_size = 0;
@@ -712,14 +727,21 @@ void Validator::check_value(const std::string& key_path, const T& value, const C
 }
 
 /// Checks every field's constraint and every cross-field rule; returns the
-/// problems found, one message per line ("" when valid).
+/// problems found, each with the key path it is about.
 template <Visitable T>
-std::string validate(const T& value, const std::string& prefix = "") {
+std::vector<Problem> validation_problems(const T& value, const std::string& prefix = "") {
   ErrorList errors;
   Validator v(prefix, &errors);
   const_cast<T&>(value).visit(v);
+  return errors.problems();
+}
+
+/// validation_problems() as text: one message per line ("" when valid).
+template <Visitable T>
+std::string validate(const T& value, const std::string& prefix = "") {
   std::string out;
-  for (const auto& m : errors.messages()) out += (out.empty() ? "" : "\n") + m;
+  for (const Problem& p : validation_problems(value, prefix))
+    out += (out.empty() ? "" : "\n") + p.message;
   return out;
 }
 

@@ -45,22 +45,22 @@ std::string where_key(const YAML::Node& root, const std::string& label,
   return fmt::format("{}:{}:{}", label, mark.line + 1, mark.column + 1);
 }
 
-// `message` (about the key path it starts with, e.g. "pipeline.fusion: got ..." or
-// "mission.waypoints_ne_m[3]: ...") prefixed with "FILE:LINE:COL" of that key in the file; as it
-// was when the file does not give the key (a default, or a --set: a parent's line would point
-// at what the user did not write).
-std::string located(const YAML::Node& root, const std::string& label, const std::string& message) {
-  const std::string path = message.substr(0, message.find_first_of(" :"));
+// The problem's message prefixed with "FILE:LINE:COL" of its key path (e.g. "pipeline.fusion",
+// "mission.waypoints_ne_m[3]") in the file; the message alone when it has no path or the file
+// does not give the key (a default, or a --set: a parent's line would point at what the user
+// did not write).
+std::string located(const YAML::Node& root, const std::string& label, const yaml::Problem& p) {
+  const std::string& path = p.path;
   YAML::Node node;
   node.reset(root);
   YAML::Mark mark = YAML::Mark::null_mark();
   std::size_t start = 0;
-  while (start <= path.size()) {
+  while (!path.empty() && start <= path.size()) {
     const std::size_t dot = std::min(path.find('.', start), path.size());
     const std::string part = path.substr(start, dot - start);
     const std::size_t bracket = part.find('[');
     const std::string key = part.substr(0, bracket);
-    if (key.empty() || !node.IsMap() || !node[key]) return message;
+    if (key.empty() || !node.IsMap() || !node[key]) return p.message;
     node.reset(node[key]);
     mark = node.Mark();
     std::uint64_t index = 0;
@@ -72,8 +72,8 @@ std::string located(const YAML::Node& root, const std::string& label, const std:
     }
     start = dot + 1;
   }
-  if (mark.is_null()) return message;
-  return fmt::format("{}:{}:{}: {}", label, mark.line + 1, mark.column + 1, message);
+  if (mark.is_null()) return p.message;
+  return fmt::format("{}:{}:{}: {}", label, mark.line + 1, mark.column + 1, p.message);
 }
 
 // Reads "north_m,east_m" lines ('#' comments, blank lines and an optional
@@ -138,37 +138,41 @@ void resolve_files(Scenario* s, const YAML::Node& root, const std::string& label
 
 }  // namespace
 
-std::vector<std::string> scenario_problems(const Scenario& s) {
-  const std::string problems = yaml::validate(s);
+std::vector<yaml::Problem> scenario_problems(const Scenario& s) {
   yaml::ErrorList errors;
-  if (!problems.empty()) errors.add(problems);
+  for (yaml::Problem& p : yaml::validation_problems(s))
+    errors.add_at(std::move(p.path), std::move(p.message));
   if (s.mission.type == sim::MissionType::kWaypoints && s.mission.waypoints_ne_m.size() < 2)
-    errors.add(
-        fmt::format("mission.waypoints_ne_m: got {} waypoints, expected at least 2 for "
-                    "mission type 'waypoints'",
-                    s.mission.waypoints_ne_m.size()));
+    errors.add_at("mission.waypoints_ne_m",
+                  fmt::format("mission.waypoints_ne_m: got {} waypoints, expected at least 2 for "
+                              "mission type 'waypoints'",
+                              s.mission.waypoints_ne_m.size()));
   if (s.pipeline.vo.empty() && !s.pipeline.fusion.empty())
-    errors.add(
-        "pipeline.fusion: got filters but no VO to feed them, expected pipeline.vo to "
-        "name at least one VO algorithm");
+    errors.add_at("pipeline.fusion",
+                  "pipeline.fusion: got filters but no VO to feed them, expected pipeline.vo to "
+                  "name at least one VO algorithm");
   std::set<std::string> external_names;
   for (const auto& e : s.pipeline.external_vo) {
     constexpr std::string_view kNameChars =
         "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-";
     const auto& built_in = vo::built_in_vo_names();
     if (std::find(built_in.begin(), built_in.end(), e.name) != built_in.end())
-      errors.add(fmt::format(
-          "pipeline.external_vo: name: got '{}', a built-in VO's name, expected another name",
-          e.name));
+      errors.add_at(
+          "pipeline.external_vo",
+          fmt::format(
+              "pipeline.external_vo: name: got '{}', a built-in VO's name, expected another name",
+              e.name));
     else if (e.name.find_first_not_of(kNameChars) != std::string::npos)
-      errors.add(
-          fmt::format("pipeline.external_vo: name: got '{}', expected letters, digits, "
-                      "'_' and '-' only (it names files)",
-                      e.name));
+      errors.add_at("pipeline.external_vo",
+                    fmt::format("pipeline.external_vo: name: got '{}', expected letters, digits, "
+                                "'_' and '-' only (it names files)",
+                                e.name));
     else if (!external_names.insert(e.name).second)
-      errors.add(fmt::format(
-          "pipeline.external_vo: name: got '{}' twice, expected a different name for each",
-          e.name));
+      errors.add_at(
+          "pipeline.external_vo",
+          fmt::format(
+              "pipeline.external_vo: name: got '{}' twice, expected a different name for each",
+              e.name));
   }
   // The camera clock's stamps must stay within the association tolerance of
   // the true frame times, or no estimate would be paired with ground truth.
@@ -176,19 +180,22 @@ std::vector<std::string> scenario_problems(const Scenario& s) {
   const double stamp_error_s = (std::abs(clock.offset_ms) + 3 * clock.jitter_ms) * 1e-3;
   if ((!s.pipeline.vo.empty() || !s.pipeline.external_vo.empty()) &&
       stamp_error_s > s.eval.association_tolerance_s)
-    errors.add(fmt::format(
-        "sensors.camera.clock: got offset_ms {} and jitter_ms {}, stamps up to {} s from the "
-        "true frame times, expected at most eval.association_tolerance_s = {} s (raise it, "
-        "below half the frame period, to evaluate a camera with this clock)",
-        clock.offset_ms, clock.jitter_ms, stamp_error_s, s.eval.association_tolerance_s));
+    errors.add_at(
+        "sensors.camera.clock",
+        fmt::format(
+            "sensors.camera.clock: got offset_ms {} and jitter_ms {}, stamps up to {} s from the "
+            "true frame times, expected at most eval.association_tolerance_s = {} s (raise it, "
+            "below half the frame period, to evaluate a camera with this clock)",
+            clock.offset_ms, clock.jitter_ms, stamp_error_s, s.eval.association_tolerance_s));
   if (errors.empty())  // combinations only once every value is in range
-    for (const std::string& problem : impossible_combinations(s)) errors.add(problem);
-  return errors.messages();
+    for (yaml::Problem& p : impossible_combinations(s))
+      errors.add_at(std::move(p.path), std::move(p.message));
+  return errors.problems();
 }
 
 void validate_scenario(const Scenario& s, const std::string& label) {
   yaml::ErrorList errors;
-  for (const std::string& problem : scenario_problems(s)) errors.add(problem);
+  for (const yaml::Problem& p : scenario_problems(s)) errors.add(p.message);
   errors.throw_if_any(label + ": invalid scenario:");
 }
 
@@ -204,7 +211,7 @@ Scenario parse_scenario(const std::string& text, const std::string& label,
   }
   resolve_files(&s, root, label, base_dir);
   yaml::ErrorList errors;
-  for (const std::string& problem : scenario_problems(s)) errors.add(located(root, label, problem));
+  for (const yaml::Problem& p : scenario_problems(s)) errors.add(located(root, label, p));
   errors.throw_if_any(label + ": invalid scenario:");
   return s;
 }

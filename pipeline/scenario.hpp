@@ -188,9 +188,10 @@ Scenario parse_scenario(const std::string& text, const std::string& label,
                         const std::filesystem::path& base_dir,
                         const std::vector<std::string>& overrides = {});
 
-/// What breaks the rules that span sections (one message each, starting with the key path);
-/// empty when the scenario can run.
-std::vector<std::string> scenario_problems(const Scenario& scenario);
+/// Every value out of its range and every rule broken, those that span sections included:
+/// each problem with the key path it is about and a message starting with it; empty when the
+/// scenario can run.
+std::vector<yaml::Problem> scenario_problems(const Scenario& scenario);
 
 /// Throws UserError with every problem of scenario_problems(), under "LABEL: invalid scenario:".
 /// (parse_scenario() and load_scenario() check the same, and say where in the file.)

@@ -16,6 +16,7 @@ constexpr double kMicheSteepness = 0.142;
 
 struct RegularWave {
   std::string keys;  // the keys that set it, for messages
+  std::string path;  // the first of them, where the message points in the file
   double height_m = 0;
   double wavelength_m = 0;
 };
@@ -31,8 +32,8 @@ std::vector<RegularWave> regular_waves(const sim::WaveOptions& w) {
   std::vector<RegularWave> out;
   const auto one = [&](const sim::WaveComponentOptions& a, const std::string& at) {
     const std::string period = a.period_s > 0 ? "period_s" : "wavelength_m";
-    out.push_back({fmt::format("{0}.amplitude_m and {0}.{1}", at, period), 2 * a.amplitude_m,
-                   wavelength_of(a, w.water_depth_m)});
+    out.push_back({fmt::format("{0}.amplitude_m and {0}.{1}", at, period), at + ".amplitude_m",
+                   2 * a.amplitude_m, wavelength_of(a, w.water_depth_m)});
   };
   if (w.model == sim::WaveModel::kAiry) one(w.airy, "water.waves.airy");
   if (w.model == sim::WaveModel::kComponents)
@@ -41,7 +42,8 @@ std::vector<RegularWave> regular_waves(const sim::WaveOptions& w) {
   if (w.model == sim::WaveModel::kJonswap) {
     const double k =
         sim::dispersion_wavenumber(2 * std::numbers::pi / w.peak_period_s, w.water_depth_m);
-    out.push_back({"water.waves.significant_height_m and peak_period_s", w.significant_height_m,
+    out.push_back({"water.waves.significant_height_m and peak_period_s",
+                   "water.waves.significant_height_m", w.significant_height_m,
                    2 * std::numbers::pi / k});
   }
   return out;
@@ -62,26 +64,30 @@ void check_steepness(const Scenario& s, std::vector<std::string>* out) {
   }
 }
 
-void check_waves(const Scenario& s, std::vector<std::string>* out) {
+void check_waves(const Scenario& s, std::vector<yaml::Problem>* out) {
   for (const RegularWave& r : regular_waves(s.water.waves)) {
     const auto& basin = s.scene.wave_basin;
     if (s.scene.type == scenes::SceneType::kWaveBasin && r.wavelength_m > basin.length_m)
-      out->push_back(fmt::format(
-          "{} with scene.wave_basin.length_m: got a wave {:.3g} m long in a basin {} m long, "
-          "expected a wave shorter than the basin",
-          r.keys, r.wavelength_m, basin.length_m));
+      out->push_back(
+          {r.path,
+           fmt::format(
+               "{} with scene.wave_basin.length_m: got a wave {:.3g} m long in a basin {} m long, "
+               "expected a wave shorter than the basin",
+               r.keys, r.wavelength_m, basin.length_m)});
   }
 }
 
 // Box hull floating level at rest: draft = mass / (rho L B).
-void check_hull(const Scenario& s, std::vector<std::string>* out) {
+void check_hull(const Scenario& s, std::vector<yaml::Problem>* out) {
   const auto& v = s.vessel;
   const double draft_m = v.mass_kg / (sim::kWaterDensity_kg_m3 * v.hull.length_m * v.hull.beam_m);
   if (draft_m >= v.hull.depth_m) {
-    out->push_back(fmt::format(
-        "vessel.mass_kg with vessel.hull.length_m, beam_m and depth_m: got {} kg in a {} x {} "
-        "x {} m box, a draft of {:.3g} m, expected a draft below the hull depth (it sinks)",
-        v.mass_kg, v.hull.length_m, v.hull.beam_m, v.hull.depth_m, draft_m));
+    out->push_back(
+        {"vessel.mass_kg",
+         fmt::format(
+             "vessel.mass_kg with vessel.hull.length_m, beam_m and depth_m: got {} kg in a {} x {} "
+             "x {} m box, a draft of {:.3g} m, expected a draft below the hull depth (it sinks)",
+             v.mass_kg, v.hull.length_m, v.hull.beam_m, v.hull.depth_m, draft_m)});
     return;
   }
   // The camera's height above the still water at rest: CG at kg_m above the keel, the
@@ -89,11 +95,13 @@ void check_hull(const Scenario& s, std::vector<std::string>* out) {
   const double camera_above_water_m =
       v.hull.kg_m - s.sensors.camera.mount.position_frd_m[2] - draft_m;
   if (camera_above_water_m <= 0)
-    out->push_back(fmt::format(
-        "sensors.camera.mount.position_frd_m[2] with vessel.hull.kg_m and vessel.mass_kg: the "
-        "camera sits {:.3g} m below the still water at rest (draft {:.3g} m), expected it "
-        "above the water line",
-        -camera_above_water_m, draft_m));
+    out->push_back(
+        {"sensors.camera.mount.position_frd_m[2]",
+         fmt::format(
+             "sensors.camera.mount.position_frd_m[2] with vessel.hull.kg_m and vessel.mass_kg: the "
+             "camera sits {:.3g} m below the still water at rest (draft {:.3g} m), expected it "
+             "above the water line",
+             -camera_above_water_m, draft_m)});
 }
 
 // Whether north/east lies on the water of the scene.
@@ -115,12 +123,12 @@ std::string scene_extent(const Scenario& s) {
       b.beach_distance_m, b.width_m / 2);
 }
 
-void check_mission(const Scenario& s, std::vector<std::string>* out) {
+void check_mission(const Scenario& s, std::vector<yaml::Problem>* out) {
   const auto& start = s.vessel.start_ne_m;
   const auto point = [&](const std::string& key, double n, double e) {
     if (!on_water(s, n, e))
-      out->push_back(
-          fmt::format("{}: got ({}, {}), expected a point on {}", key, n, e, scene_extent(s)));
+      out->push_back({key, fmt::format("{}: got ({}, {}), expected a point on {}", key, n, e,
+                                       scene_extent(s))});
   };
   point("vessel.start_ne_m", start[0], start[1]);
   const auto& m = s.mission;
@@ -130,27 +138,31 @@ void check_mission(const Scenario& s, std::vector<std::string>* out) {
             m.waypoints_ne_m[i][1]);
   if (m.type == sim::MissionType::kTransects && s.scene.type == scenes::SceneType::kRiverReach &&
       m.crossing_width_m >= s.scene.river_reach.river_width_m)
-    out->push_back(fmt::format(
-        "mission.crossing_width_m with scene.river_reach.river_width_m: got crossings {} m "
-        "long on a river {} m wide, expected crossings shorter than the river is wide",
-        m.crossing_width_m, s.scene.river_reach.river_width_m));
+    out->push_back(
+        {"mission.crossing_width_m",
+         fmt::format(
+             "mission.crossing_width_m with scene.river_reach.river_width_m: got crossings {} m "
+             "long on a river {} m wide, expected crossings shorter than the river is wide",
+             m.crossing_width_m, s.scene.river_reach.river_width_m)});
   if ((m.type == sim::MissionType::kTow || m.type == sim::MissionType::kStraight) &&
       s.scene.type == scenes::SceneType::kWaveBasin) {
     const double h = s.vessel.start_heading_deg * std::numbers::pi / 180;
     const double n = start[0] + m.survey_length_m * std::cos(h);
     const double e = start[1] + m.survey_length_m * std::sin(h);
     if (on_water(s, start[0], start[1]) && !on_water(s, n, e))
-      out->push_back(fmt::format(
-          "mission.survey_length_m with vessel.start_ne_m and start_heading_deg: the track "
-          "ends at ({:.3g}, {:.3g}), expected it to end on {}",
-          n, e, scene_extent(s)));
+      out->push_back(
+          {"mission.survey_length_m",
+           fmt::format(
+               "mission.survey_length_m with vessel.start_ne_m and start_heading_deg: the track "
+               "ends at ({:.3g}, {:.3g}), expected it to end on {}",
+               n, e, scene_extent(s))});
   }
 }
 
 }  // namespace
 
-std::vector<std::string> impossible_combinations(const Scenario& scenario) {
-  std::vector<std::string> out;
+std::vector<yaml::Problem> impossible_combinations(const Scenario& scenario) {
+  std::vector<yaml::Problem> out;
   check_waves(scenario, &out);
   check_hull(scenario, &out);
   check_mission(scenario, &out);

@@ -7,12 +7,14 @@
 #include <string>
 #include <vector>
 
+#include "core/yaml_io.hpp"
 #include "pipeline/scenario.hpp"
 
 namespace driftlab::pipeline {
 
-/// One message per impossible combination; empty when the scenario can run.
-std::vector<std::string> impossible_combinations(const Scenario& scenario);
+/// One problem per impossible combination (its path the first key the message names);
+/// empty when the scenario can run.
+std::vector<yaml::Problem> impossible_combinations(const Scenario& scenario);
 
 /// Values that run but that nature would not give, as warnings (`scenario check` prints them,
 /// a run records them in metrics.json "warnings" and the report): a regular wave steeper than
