@@ -8,6 +8,7 @@
 
 #include "core/hash.hpp"
 #include "core/yaml_io.hpp"
+#include "sim/waves/ripple_spectrum.hpp"
 
 namespace driftlab::pipeline {
 namespace {
@@ -55,8 +56,8 @@ Scenario frame_deciding(const Scenario& sc) {
 }  // namespace
 
 std::string renderer_identity(const std::string& gl_context) {
-  return fmt::format("code {}\nopencv {}\ngl {}\n", renderer_code_identity(),
-                     cv::getVersionString(), gl_context);
+  return fmt::format("code {}\nopencv {}\nfft {}\ngl {}\n", renderer_code_identity(),
+                     cv::getVersionString(), sim::fft_library_version(), gl_context);
 }
 
 std::string scene_fingerprint(const sim::SceneGeometry& scene) {

@@ -29,7 +29,8 @@ namespace driftlab::pipeline {
 /// The build-time part of the renderer's identity: "SHA256 (N files)" (generated source).
 const char* renderer_code_identity();
 
-/// The renderer's identity as the key's first lines: code, OpenCV, and `gl_context` (the
+/// The renderer's identity as the key's first lines: code, OpenCV, FFTW (the wind ripples'
+/// slope maps), and `gl_context` (the
 /// context's description, sim::GlContext::description()).
 std::string renderer_identity(const std::string& gl_context);
 

@@ -50,6 +50,8 @@ std::mutex& fftw_planner_mutex() {
 
 }  // namespace
 
+std::string fft_library_version() { return fftwf_version; }
+
 double gravity_capillary_omega(double k_rad_m) {
   const double r = k_rad_m / kKm_rad_m;
   return std::sqrt(kGravity_m_s2 * k_rad_m * (1.0 + r * r));

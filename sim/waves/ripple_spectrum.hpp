@@ -8,12 +8,17 @@
 #include <array>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "core/rng.hpp"
 #include "sim/waves/wave_options.hpp"
 
 namespace driftlab::sim {
+
+/// The FFT library's version and build ("fftw-3.3.10-sse2-avx2"): its plans, and so the
+/// slope maps' last bits, depend on them (a part of the frame cache's key).
+std::string fft_library_version();
 
 /// Deep-water dispersion of gravity-capillary waves:
 /// omega^2 = g k (1 + (k / k_m)^2), k_m = 370 rad/m (Elfouhaily et al. 1997, Sec. 2).
