@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <future>
+#include <limits>
 #include <vector>
 
 #include "core/error.hpp"
@@ -20,6 +21,28 @@ cv::Mat as_mat(sim::GrayImage* img) {
 
 }  // namespace
 
+double run_right_offset_s(const sim::CameraOptions& c, const RngStreams& rng) {
+  const double spread_s = c.right_offset_spread_ms * 1e-3;
+  const double drawn = spread_s > 0 ? rng.stream("camera.right_offset").uniform(-spread_s, spread_s)
+                                    : 0.0;
+  return c.right_offset_ms * 1e-3 + drawn;
+}
+
+std::vector<ShutterBand> shutter_bands(int height, double line_delay_s, int bands) {
+  DRIFTLAB_DEMAND(height >= 1 && bands >= 1 && bands <= height);
+  std::vector<ShutterBand> out;
+  out.reserve(static_cast<std::size_t>(bands));
+  const int base = height / bands, taller = height % bands;
+  int row = 0;
+  for (int b = 0; b < bands; ++b) {
+    const int end = row + base + (b < taller ? 1 : 0);
+    const double centre_row = (row + end - 1) / 2.0;
+    out.push_back({row, end, (centre_row - (height - 1) / 2.0) * line_delay_s});
+    row = end;
+  }
+  return out;
+}
+
 CameraStage::CameraStage(const Scenario& sc, sim::StereoRenderer* renderer, const RngStreams& rng)
     : renderer_(renderer),
       T_B_C_(camera_mount_T_B_C(sc.sensors.camera.mount)),
@@ -31,6 +54,14 @@ CameraStage::CameraStage(const Scenario& sc, sim::StereoRenderer* renderer, cons
               .cy = sc.sensors.camera.cy_px,
               .width = sc.sensors.camera.width_px,
               .height = sc.sensors.camera.height_px},
+      shutter_(sc.sensors.camera.shutter),
+      line_delay_s_(sc.sensors.camera.line_delay_us * 1e-6),
+      band_step_px_(sc.render.rolling_shutter_step_px),
+      max_bands_(sc.render.rolling_shutter_max_bands),
+      near_m_(sc.render.rolling_shutter_near_m),
+      right_offset_s_(run_right_offset_s(sc.sensors.camera, rng)),
+      right_jitter_s_(sc.sensors.camera.right_offset_jitter_ms * 1e-3),
+      right_jitter_(rng.stream("camera.right_offset.jitter")),
       exposure_ms_(sc.sensors.camera.exposure_ms),
       auto_exposure_(sc.sensors.camera.auto_exposure),
       left_noise_(sc.sensors.camera, rng, "camera.left"),
@@ -63,18 +94,57 @@ int CameraStage::blur_samples(const FrameTruth& truth) const {
   return needed >= blur_samples_ ? blur_samples_ : std::max(1, static_cast<int>(needed));
 }
 
+SE3 CameraStage::T_W_C(const FrameTruth& truth, double dt_s) const {
+  if (dt_s == 0) return T_W_C(truth);
+  return truth.T_W_B * SE3::exp(truth.twist_B * dt_s) * T_B_C_;
+}
+
+double CameraStage::corner_motion_px(const SE3& T_a_b, double depth_m) const {
+  double motion_px = 0;
+  for (const double u : {-0.5, camera_.width - 0.5})
+    for (const double v : {-0.5, camera_.height - 0.5}) {
+      const Vec3 p_a = T_a_b * camera_.unproject(Eigen::Vector2d(u, v), depth_m);
+      if (p_a.z() <= 0) return std::numeric_limits<double>::infinity();  // moved out of view
+      motion_px = std::max(motion_px, (camera_.project(p_a) - Eigen::Vector2d(u, v)).norm());
+    }
+  return motion_px;
+}
+
+int CameraStage::rolling_bands(const FrameTruth& truth) const {
+  if (shutter_ != sim::Shutter::kRolling || camera_.height <= 1) return 1;
+  const double readout_s = (camera_.height - 1) * line_delay_s_;
+  const SE3 T_first_last =
+      T_W_C(truth, -readout_s / 2).inverse() * T_W_C(truth, readout_s / 2);
+  const double needed = std::ceil(corner_motion_px(T_first_last, near_m_) / band_step_px_);
+  const int most = std::min(max_bands_, camera_.height);
+  return needed >= most ? most : std::max(1, static_cast<int>(needed));
+}
+
+sim::StereoImages CameraStage::render_at(const FrameTruth& truth,
+                                         const std::vector<ShutterBand>& bands, double d_s) {
+  std::vector<sim::RowBand> left, right;
+  for (const ShutterBand& b : bands) {
+    const double dl = b.dt_s + d_s, dr = dl + last_right_offset_s_;
+    left.push_back({T_W_C(truth, dl), truth.t_s + dl, b.row_begin, b.row_end});
+    right.push_back({T_W_C(truth, dr), truth.t_s + dr, b.row_begin, b.row_end});
+  }
+  return renderer_->render_bands(left, right);
+}
+
 sim::StereoImages CameraStage::render_blurred(const FrameTruth& truth) {
   const double exposure_s = exposure_ms_ * 1e-3;
   const int samples = blur_samples(truth);
   last_blur_samples_ = samples;
-  if (samples <= 1) return renderer_->render(T_W_C(truth), truth.t_s, false);
+  last_rolling_bands_ = rolling_bands(truth);
+  const std::vector<ShutterBand> bands =
+      shutter_bands(camera_.height, line_delay_s_, last_rolling_bands_);
+  if (samples <= 1) return render_at(truth, bands, 0.0);
   // Sub-frame instants at the centres of `samples` equal parts of the exposure.
   std::vector<std::uint32_t> sum_left, sum_right;
   sim::StereoImages out;
   for (int s = 0; s < samples; ++s) {
     const double d = ((s + 0.5) / samples - 0.5) * exposure_s;
-    const SE3 T_W_B = truth.T_W_B * SE3::exp(truth.twist_B * d);
-    sim::StereoImages img = renderer_->render(T_W_B * T_B_C_, truth.t_s + d, false);
+    sim::StereoImages img = render_at(truth, bands, d);
     if (s == 0) {
       sum_left.assign(img.left.pixels.size(), 0);
       sum_right.assign(img.right.pixels.size(), 0);
@@ -96,6 +166,9 @@ sim::StereoImages CameraStage::render_blurred(const FrameTruth& truth) {
 }
 
 sim::StereoImages CameraStage::capture(const FrameTruth& truth) {
+  last_right_offset_s_ = right_offset_s_;
+  if (right_jitter_s_ > 0)
+    last_right_offset_s_ += right_jitter_s_ * std::clamp(right_jitter_.normal(), -3.0, 3.0);
   sim::StereoImages img = render_blurred(truth);
   // Lens and noise of the two cameras are independent (separate streams):
   // the left one runs on a second thread, the bytes are the same either way.

@@ -8,6 +8,11 @@
 //     twist at the frame time, T_W_B(t + d) = T_W_B(t) exp(d [v_B; w_B]).
 //     With render.motion_blur_step_px, as few samples as keep the image's
 //     motion between two of them within that step (blur_samples());
+//     With a rolling shutter (sensors.camera.shutter), each render draws the
+//     image in bands of rows, each band from the pose of its own time
+//     (shutter_bands(), rolling_bands()); the blur's instants are spread about
+//     each band's time. With an unsynchronised pair (right_offset_*), the right
+//     image's times are shifted by the frame's offset (right_offset_s());
 //  2. the true stereo rig: the right camera is rendered where the
 //     miscalibrated rig puts it (sensors.camera.calibration_error), the VO is
 //     told the nominal one;
@@ -23,6 +28,7 @@
 
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "core/camera.hpp"
 #include "core/rng.hpp"
@@ -33,6 +39,23 @@
 #include "sim/sensors/lens.hpp"
 
 namespace driftlab::pipeline {
+
+/// A band of image rows exposed together, centred dt_s after the frame time.
+struct ShutterBand {
+  int row_begin = 0;
+  int row_end = 0;  // one past the last row
+  double dt_s = 0;
+};
+
+/// The rows of an image `height` rows high in `bands` bands of equal height (the first ones a
+/// row taller where they do not divide), each exposed at its centre row's time: row r's
+/// exposure is centred (r - (height - 1) / 2) line_delay_s after the frame time (the frame
+/// time is the middle row's mid-exposure).
+std::vector<ShutterBand> shutter_bands(int height, double line_delay_s, int bands);
+
+/// The right image's exposure minus the left's in a run of this seed, before each frame's
+/// jitter: right_offset_ms plus the run's draw within +-right_offset_spread_ms [s].
+double run_right_offset_s(const sim::CameraOptions& camera, const RngStreams& rng);
 
 /// The true state of the camera's platform at a frame.
 struct FrameTruth {
@@ -57,13 +80,32 @@ class CameraStage {
   /// river's speeds below a pixel: 0.5 m/s over 5 ms moves a point 5 m away by 0.4 px at
   /// f = 817 px).
   int blur_samples(const FrameTruth& truth) const;
+  /// How many bands of rows a rolling-shutter frame with this truth is drawn in (1 with a global
+  /// shutter): the fewest that keep the image motion over one band's share of the readout
+  /// within render.rolling_shutter_step_px, at most render.rolling_shutter_max_bands. The motion
+  /// is the largest shift of the four image corners over the readout, each ray moved by the
+  /// camera's rotation and by its translation seen at render.rolling_shutter_near_m.
+  int rolling_bands(const FrameTruth& truth) const;
+  /// The bands the last capture() took.
+  int last_rolling_bands() const { return last_rolling_bands_; }
+  /// The right image's exposure minus the left's for the last capture() [s].
+  double last_right_offset_s() const { return last_right_offset_s_; }
   /// The samples the last capture() took.
   int last_blur_samples() const { return last_blur_samples_; }
   /// Left-camera pose at the centre of the exposure.
   SE3 T_W_C(const FrameTruth& truth) const { return truth.T_W_B * T_B_C_; }
+  /// Left-camera pose dt_s after the frame time, the body moving with its twist at the frame
+  /// time: T_W_B(t + d) = T_W_B(t) exp(d [v_B; w_B]).
+  SE3 T_W_C(const FrameTruth& truth, double dt_s) const;
 
  private:
   sim::StereoImages render_blurred(const FrameTruth& truth);
+  // One render of the pair, every row exposed d_s after its own time.
+  sim::StereoImages render_at(const FrameTruth& truth, const std::vector<ShutterBand>& bands,
+                              double d_s);
+  // The image motion [px] of the left camera's four corners from pose a to pose b (C(a) <- C(b)
+  // relative motion), points at depth `depth_m`.
+  double corner_motion_px(const SE3& T_a_b, double depth_m) const;
 
   sim::StereoRenderer* renderer_;
   SE3 T_B_C_;
@@ -71,6 +113,16 @@ class CameraStage {
   double blur_step_px_;
   PinholeCamera camera_;  // the left camera's intrinsics, for blur_samples()
   int last_blur_samples_ = 1;
+  sim::Shutter shutter_;
+  double line_delay_s_;
+  double band_step_px_;
+  int max_bands_;
+  double near_m_;
+  int last_rolling_bands_ = 1;
+  double right_offset_s_;  // the run's constant part (right_offset_ms + the run's draw)
+  double right_jitter_s_;
+  Rng right_jitter_;
+  double last_right_offset_s_ = 0;
   double exposure_ms_;
   sim::AutoExposureOptions auto_exposure_;
   sim::CameraImageNoise left_noise_, right_noise_;

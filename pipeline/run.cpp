@@ -456,6 +456,10 @@ CameraRecord camera_record(const Scenario& sc, std::size_t frames, std::size_t d
   c.motion_blur_step_px = sc.render.motion_blur_step_px;
   c.lens_distortion = cam.lens_distortion.enabled;
   c.clock_offset_ms = cam.clock.offset_ms;
+  c.shutter = std::string(yaml::enum_name(cam.shutter));
+  c.line_delay_us = cam.shutter == sim::Shutter::kRolling ? cam.line_delay_us : 0.0;
+  c.right_offset_ms = 1e3 * run_right_offset_s(cam, RngStreams(sc.seed));
+  c.right_offset_jitter_ms = cam.right_offset_jitter_ms;
   return c;
 }
 

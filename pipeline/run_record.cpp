@@ -42,7 +42,11 @@ void VisionRecord::add_to(nlohmann::json* metrics) const {
                  {"motion_blur_samples", camera.motion_blur_samples},
                  {"motion_blur_step_px", camera.motion_blur_step_px},
                  {"lens_distortion", camera.lens_distortion},
-                 {"clock_offset_ms", camera.clock_offset_ms}};
+                 {"clock_offset_ms", camera.clock_offset_ms},
+                 {"shutter", camera.shutter},
+                 {"line_delay_us", camera.line_delay_us},
+                 {"right_offset_ms", camera.right_offset_ms},
+                 {"right_offset_jitter_ms", camera.right_offset_jitter_ms}};
   m["frame_cache"] = {
       {"state", frame_cache.state}, {"entry", frame_cache.entry}, {"note", frame_cache.note}};
   m["render"] = {{"context", render_context}, {"assets", assets}, {"triangles", triangles}};

@@ -63,6 +63,10 @@ struct CameraRecord {
   bool noise = false, lens_distortion = false;
   double vignetting_strength = 0, motion_blur_step_px = 0, clock_offset_ms = 0;
   int motion_blur_samples = 0;
+  std::string shutter = "global";
+  double line_delay_us = 0;
+  double right_offset_ms = 0;  ///< the right image's offset in this run (its spread drawn)
+  double right_offset_jitter_ms = 0;
 };
 
 /// The render, VO, fusion and evaluation stages of a scenario run, when they ran.

@@ -30,6 +30,9 @@ struct RenderOptions {
   bool reflections = true;
   int motion_blur_samples = 1;
   double motion_blur_step_px = 0;
+  double rolling_shutter_step_px = 0.2;
+  int rolling_shutter_max_bands = 64;
+  double rolling_shutter_near_m = 1.0;
 
   template <class A>
   void visit(A& a) {
@@ -59,6 +62,19 @@ struct RenderOptions {
       "most motion_blur_samples), so only the turns pay for blur. 0 = every frame takes "
       "motion_blur_samples [px]",
       yaml::at_least(0));
+    a("rolling_shutter_step_px", rolling_shutter_step_px,
+      "With sensors.camera.shutter: rolling, the image is drawn in bands of rows, each from the "
+      "pose at its centre row's time: as few bands as keep the image's motion from one band to "
+      "the next within this step, so no row is off by more than half of it (rotation over the "
+      "readout, and translation seen at rolling_shutter_near_m) [px]",
+      yaml::positive() & yaml::up_to(100, "no rolling shutter at all"));
+    a("rolling_shutter_max_bands", rolling_shutter_max_bands,
+      "Most bands of rows a rolling-shutter image is drawn in (each costs one more pass)",
+      yaml::in_range(1, 4096));
+    a("rolling_shutter_near_m", rolling_shutter_near_m,
+      "Nearest depth whose motion the rolling shutter's bands keep within "
+      "rolling_shutter_step_px [m]",
+      yaml::positive());
   }
 };
 

@@ -140,6 +140,10 @@ struct StereoRenderer::Impl {
   void draw_reflection(const SE3& T_W_C, int eye);
   // The eye's image: the water (with its reflection texture), the scene, the sky.
   void draw_eye(const SE3& T_W_C, double t, int eye);
+  // draw_eye in steps: clear, draw rows [row_begin, row_end) (any number of times), resolve.
+  void clear_eye(int eye);
+  void draw_eye_rows(const SE3& T_W_C, double t, int eye, int row_begin, int row_end);
+  void resolve_eye(int eye);
   GrayImage read_eye(int eye);
   DepthImage render_depth(const SE3& T_W_C, double t);
 };
@@ -658,7 +662,16 @@ void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, int eye_index) {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-void StereoRenderer::Impl::draw_eye(const SE3& T_W_C, double t, int eye_index) {
+void StereoRenderer::Impl::clear_eye(int eye_index) {
+  const EyeTargets& e = eyes[static_cast<std::size_t>(eye_index)];
+  glBindFramebuffer(GL_FRAMEBUFFER, e.msaa_fbo);
+  glViewport(0, 0, rig.camera.width, rig.camera.height);
+  glClearColor(0, 0, 0, 1);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+}
+
+void StereoRenderer::Impl::draw_eye_rows(const SE3& T_W_C, double t, int eye_index,
+                                         int row_begin, int row_end) {
   const EyeTargets& e = eyes[static_cast<std::size_t>(eye_index)];
   const int W = rig.camera.width, H = rig.camera.height;
   const Eigen::Matrix4f view = to_view(T_W_C);
@@ -668,20 +681,36 @@ void StereoRenderer::Impl::draw_eye(const SE3& T_W_C, double t, int eye_index) {
   glDisable(GL_CULL_FACE);
   glBindFramebuffer(GL_FRAMEBUFFER, e.msaa_fbo);
   glViewport(0, 0, W, H);
-  glClearColor(0, 0, 0, 1);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  // Window row = image row (see projection_from_intrinsics), so the band is the scissor box.
+  const bool band = row_begin > 0 || row_end < H;
+  if (band) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(0, row_begin, W, row_end - row_begin);
+  }
   // The water first (near and large, it hides much of the banks below it),
   // then the scene nearest first, then the sky on the far plane where nothing
   // was drawn: every pixel is shaded about once.
   draw_water(view, eye, t, 0, reflects() ? e.refl_tex : 0);
   draw_scene(view, eye, 1.f, 0);
   draw_sky(view);
-  if (options.msaa_samples > 1) {
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, e.msaa_fbo);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.resolve_fbo);
-    glBlitFramebuffer(0, 0, W, H, 0, 0, W, H, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-  }
+  if (band) glDisable(GL_SCISSOR_TEST);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void StereoRenderer::Impl::resolve_eye(int eye_index) {
+  if (options.msaa_samples <= 1) return;
+  const EyeTargets& e = eyes[static_cast<std::size_t>(eye_index)];
+  const int W = rig.camera.width, H = rig.camera.height;
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, e.msaa_fbo);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.resolve_fbo);
+  glBlitFramebuffer(0, 0, W, H, 0, 0, W, H, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void StereoRenderer::Impl::draw_eye(const SE3& T_W_C, double t, int eye_index) {
+  clear_eye(eye_index);
+  draw_eye_rows(T_W_C, t, eye_index, 0, rig.camera.height);
+  resolve_eye(eye_index);
 }
 
 GrayImage StereoRenderer::Impl::read_eye(int eye_index) {
@@ -739,6 +768,39 @@ StereoImages StereoRenderer::render(const SE3& T_W_C_left, double t_s, bool with
   if (with_depth) out.depth_left = impl_->render_depth(T_W_C_left, t_s);
   out.left = impl_->read_eye(0);
   out.right = impl_->read_eye(1);
+  return out;
+}
+
+StereoImages StereoRenderer::render_bands(const std::vector<RowBand>& left,
+                                          const std::vector<RowBand>& right) {
+  Impl& m = *impl_;
+  const int H = m.rig.camera.height;
+  const std::array<const std::vector<RowBand>*, 2> bands = {&left, &right};
+  for (const auto* eye_bands : bands) {
+    int next_row = 0;
+    for (const RowBand& b : *eye_bands) {
+      DRIFTLAB_DEMAND(b.row_begin == next_row && b.row_end > b.row_begin);
+      next_row = b.row_end;
+    }
+    DRIFTLAB_DEMAND(next_row == H);
+  }
+  if (left.size() == 1 && right.size() == 1 && left[0].t_s == right[0].t_s &&
+      left[0].T_W_C.matrix() == right[0].T_W_C.matrix())
+    return render(left[0].T_W_C, left[0].t_s, false);
+  m.context->make_current();
+  // Band by band: each band's mirror image from its own pose, then its rows.
+  for (int eye = 0; eye < 2; ++eye) {
+    m.clear_eye(eye);
+    for (const RowBand& b : *bands[static_cast<std::size_t>(eye)]) {
+      const SE3 T_W_C = eye == 0 ? b.T_W_C : b.T_W_C * m.T_left_right;
+      if (m.reflects()) m.draw_reflection(T_W_C, eye);
+      m.draw_eye_rows(T_W_C, b.t_s, eye, b.row_begin, b.row_end);
+    }
+    m.resolve_eye(eye);
+  }
+  StereoImages out;
+  out.left = m.read_eye(0);
+  out.right = m.read_eye(1);
   return out;
 }
 

@@ -50,6 +50,15 @@ struct StereoImages {
 /// y_ndc likewise with rows growing downwards (window row = image row).
 Eigen::Matrix4f projection_from_intrinsics(const PinholeCamera& camera, float near_m, float far_m);
 
+/// A band of image rows drawn from one pose at one time: a rolling shutter's
+/// rows exposed together, or the whole image (rows [0, height)).
+struct RowBand {
+  SE3 T_W_C;  // the LEFT camera's pose (world NED <- optical); the right eye adds the rig
+  double t_s = 0;
+  int row_begin = 0;
+  int row_end = 0;  // one past the last row
+};
+
 /// Largest number of wave components the water shader sums (the strongest are kept).
 constexpr int kMaxShaderWaveComponents = 32;
 
@@ -75,6 +84,10 @@ class StereoRenderer {
   void set_right_camera(const SE3& T_left_right);
   /// Renders the pair at left-camera pose T_W_C (world NED <- optical) and time t_s.
   StereoImages render(const SE3& T_W_C_left, double t_s, bool with_depth);
+  /// Renders each eye band by band (bands in row order, together covering every row once),
+  /// each band's rows from its own pose and time; the right eye's bands give the left
+  /// camera's pose at the right image's times. Without depth.
+  StereoImages render_bands(const std::vector<RowBand>& left, const std::vector<RowBand>& right);
 
   const std::string& context_description() const;
   std::size_t triangles() const;

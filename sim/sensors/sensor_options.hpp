@@ -154,6 +154,13 @@ struct LensDistortionOptions {
   }
 };
 
+/// How the image sensor exposes its rows: all at once (a CCD, or a CMOS sensor
+/// with a global shutter) or one after another (a rolling-shutter CMOS sensor).
+enum class Shutter { kGlobal, kRolling };
+constexpr auto enum_table(Shutter) {
+  return std::array{std::pair{Shutter::kGlobal, "global"}, std::pair{Shutter::kRolling, "rolling"}};
+}
+
 /// Stereo cameras of the source papers. `custom` leaves every field as given.
 enum class CameraPreset { kCustom, kBumblebee2, kPs3Eye };
 constexpr auto enum_table(CameraPreset) {
@@ -174,6 +181,11 @@ struct CameraOptions {
   double baseline_m = 0.12;
   double rate_hz = 13.0;
   double exposure_ms = 5.0;
+  Shutter shutter = Shutter::kGlobal;
+  double line_delay_us = 0.0;
+  double right_offset_ms = 0.0;
+  double right_offset_spread_ms = 0.0;
+  double right_offset_jitter_ms = 0.0;
   MountOptions mount;
   CameraNoiseOptions noise;
   double vignetting_strength = 0.0;
@@ -196,7 +208,13 @@ struct CameraOptions {
       "lens on the 4.65 um pixels of its Sony ICX204 sensor (66 deg horizontal field of view; the "
       "paper does not name the lens, Point Grey sold 2.5, 3.8 and 6 mm). ps3_eye (basin paper, "
       "Kucic and Valcic 2020, Sec. 2.2): 640x480 px at 20 Hz; fx = fy = 521 px, the PlayStation "
-      "Eye's wide 75 deg (diagonal) zoom setting; baseline 0.06 m (the paper gives none)");
+      "Eye's wide 75 deg (diagonal) zoom setting; baseline 0.06 m (the paper gives none); its "
+      "OV7720 sensor has a rolling shutter: line_delay_us 65.33, one VGA line of 784 pixel "
+      "clocks (the OV77xx VGA timing) at the 12 MHz pixel clock of the sensor's 30 fps mode (the "
+      "lowest rate of the PlayStation Eye's VGA modes that gives 20 Hz; an assumption, the paper "
+      "names no mode); the two free-running cameras paired in software: right_offset_spread_ms "
+      "16.67, half the sensor's 30 fps frame period. bumblebee2's CCDs have a global shutter "
+      "and are synchronised in hardware (offsets 0)");
     a.when_reading([this] {
       if (preset != applied_preset_) apply_preset(preset);
     });
@@ -219,6 +237,36 @@ struct CameraOptions {
       yaml::non_negative() & yaml::up_to(10000, "10 s per frame"));
     a.require(exposure_ms * 1e-3 * rate_hz <= 1.0, "exposure_ms",
               "an exposure no longer than the frame period");
+    a("shutter", shutter,
+      "global: every row exposed at once; rolling: row r exposed line_delay_us after row r - 1, "
+      "each drawn with the pose of its own time (in bands of rows, render.rolling_shutter_*). "
+      "A frame's time, its stamp and its truth are the middle row's mid-exposure (row "
+      "(height_px - 1) / 2), so the first row is exposed (height_px - 1) / 2 line delays "
+      "earlier");
+    a("line_delay_us", line_delay_us,
+      "Rolling shutter: time from one row's exposure to the next row's [us]",
+      yaml::in_range(0, 1e5));
+    a.require(shutter != Shutter::kRolling || line_delay_us > 0, "line_delay_us",
+              "a line_delay_us > 0 with shutter: rolling");
+    a.require(shutter != Shutter::kRolling || line_delay_us * 1e-6 * height_px * rate_hz <= 1.0,
+              "line_delay_us", "a readout (height_px x line_delay_us) no longer than the frame period");
+    a("right_offset_ms", right_offset_ms,
+      "Unsynchronised stereo: the right image's exposure minus the left's, the same for every "
+      "frame (the VO is told nothing, and the right image carries the left one's stamp) [ms]",
+      yaml::in_range(-1000, 1000));
+    a("right_offset_spread_ms", right_offset_spread_ms,
+      "Free-running pair: an offset drawn once per run, uniform in +-this, added to "
+      "right_offset_ms (two cameras paired in software meet at an arbitrary phase) [ms]",
+      yaml::in_range(0, 1000));
+    a("right_offset_jitter_ms", right_offset_jitter_ms,
+      "Standard deviation of a per-frame Gaussian change of the right image's offset, truncated "
+      "at 3 sigma [ms]",
+      yaml::in_range(0, 1000));
+    a.require(std::abs(right_offset_ms) + right_offset_spread_ms + 3 * right_offset_jitter_ms <=
+                  500.0 / rate_hz,
+              "right_offset_ms",
+              "a right image within half a frame period of its left one (|right_offset_ms| + "
+              "right_offset_spread_ms + 3 right_offset_jitter_ms <= 500 / rate_hz)");
     a("mount", mount, "Left camera mount on the body");
     a("noise", noise, "Photon shot noise and read noise");
     a("vignetting_strength", vignetting_strength,
@@ -250,6 +298,9 @@ inline void CameraOptions::apply_preset(CameraPreset p) {
       fx_px = fy_px = 817.0;  // 3.8 mm / 4.65 um
       baseline_m = 0.12;
       rate_hz = 8.2;
+      shutter = Shutter::kGlobal;  // CCDs, synchronised in hardware
+      line_delay_us = 0.0;
+      right_offset_ms = right_offset_spread_ms = right_offset_jitter_ms = 0.0;
       break;
     case CameraPreset::kPs3Eye:
       width_px = 640;
@@ -257,6 +308,10 @@ inline void CameraOptions::apply_preset(CameraPreset p) {
       fx_px = fy_px = 521.0;  // 400 px half diagonal / tan(75 deg / 2)
       baseline_m = 0.06;
       rate_hz = 20.0;
+      shutter = Shutter::kRolling;  // OmniVision OV7720
+      line_delay_us = 784 / 12.0;   // a VGA line of 784 pixel clocks at 12 MHz (30 fps mode)
+      right_offset_ms = right_offset_jitter_ms = 0.0;
+      right_offset_spread_ms = 1000.0 / 30 / 2;  // free-running, paired in software
       break;
   }
   if (p != CameraPreset::kCustom) {
