@@ -23,8 +23,8 @@ cv::Mat as_mat(sim::GrayImage* img) {
 
 double run_right_offset_s(const sim::CameraOptions& c, const RngStreams& rng) {
   const double spread_s = c.right_offset_spread_ms * 1e-3;
-  const double drawn = spread_s > 0 ? rng.stream("camera.right_offset").uniform(-spread_s, spread_s)
-                                    : 0.0;
+  const double drawn =
+      spread_s > 0 ? rng.stream("camera.right_offset").uniform(-spread_s, spread_s) : 0.0;
   return c.right_offset_ms * 1e-3 + drawn;
 }
 
@@ -113,8 +113,7 @@ double CameraStage::corner_motion_px(const SE3& T_a_b, double depth_m) const {
 int CameraStage::rolling_bands(const FrameTruth& truth) const {
   if (shutter_ != sim::Shutter::kRolling || camera_.height <= 1) return 1;
   const double readout_s = (camera_.height - 1) * line_delay_s_;
-  const SE3 T_first_last =
-      T_W_C(truth, -readout_s / 2).inverse() * T_W_C(truth, readout_s / 2);
+  const SE3 T_first_last = T_W_C(truth, -readout_s / 2).inverse() * T_W_C(truth, readout_s / 2);
   const double needed = std::ceil(corner_motion_px(T_first_last, near_m_) / band_step_px_);
   const int most = std::min(max_bands_, camera_.height);
   return needed >= most ? most : std::max(1, static_cast<int>(needed));

@@ -670,8 +670,8 @@ void StereoRenderer::Impl::clear_eye(int eye_index) {
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 }
 
-void StereoRenderer::Impl::draw_eye_rows(const SE3& T_W_C, double t, int eye_index,
-                                         int row_begin, int row_end) {
+void StereoRenderer::Impl::draw_eye_rows(const SE3& T_W_C, double t, int eye_index, int row_begin,
+                                         int row_end) {
   const EyeTargets& e = eyes[static_cast<std::size_t>(eye_index)];
   const int W = rig.camera.width, H = rig.camera.height;
   const Eigen::Matrix4f view = to_view(T_W_C);

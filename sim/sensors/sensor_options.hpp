@@ -249,7 +249,8 @@ struct CameraOptions {
     a.require(shutter != Shutter::kRolling || line_delay_us > 0, "line_delay_us",
               "a line_delay_us > 0 with shutter: rolling");
     a.require(shutter != Shutter::kRolling || line_delay_us * 1e-6 * height_px * rate_hz <= 1.0,
-              "line_delay_us", "a readout (height_px x line_delay_us) no longer than the frame period");
+              "line_delay_us",
+              "a readout (height_px x line_delay_us) no longer than the frame period");
     a("right_offset_ms", right_offset_ms,
       "Unsynchronised stereo: the right image's exposure minus the left's, the same for every "
       "frame (the VO is told nothing, and the right image carries the left one's stamp) [ms]",

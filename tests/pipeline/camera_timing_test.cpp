@@ -146,8 +146,8 @@ std::vector<double> rolling_edge(const sim::CameraOptions& cam, double w, double
                                  double e, double lean) {
   std::vector<double> x(static_cast<std::size_t>(cam.height_px));
   for (std::size_t row = 0; row < x.size(); ++row) {
-    const double dt = (static_cast<double>(row) - (cam.height_px - 1) / 2.0) * cam.line_delay_us *
-                      1e-6;
+    const double dt =
+        (static_cast<double>(row) - (cam.height_px - 1) / 2.0) * cam.line_delay_us * 1e-6;
     x[row] = edge_column(cam, static_cast<double>(row), w * dt, v * dt, Z, e, lean);
   }
   return x;
@@ -186,10 +186,11 @@ TEST(CameraTiming, RollingShutterShearsAVerticalEdgeUnderAYawRate) {
   const double shear = line_fit(got).second - line_fit(straight).second;
   const double closed_form = -cam.line_delay_us * 1e-6 * w * cam.fx_px;  // at the centre column
   EXPECT_NEAR(shear, closed_form * (1 + std::pow(east / north, 2)), 0.02 * std::abs(closed_form));
-  std::printf("[ measured ] yaw: %d bands, edge within %.3f px (32-row means), shear %.5f px/row "
-              "(closed form %.5f)\n",
-              stage.last_rolling_bands(), largest_window_error(got, want, 32), shear,
-              closed_form * (1 + std::pow(east / north, 2)));
+  std::printf(
+      "[ measured ] yaw: %d bands, edge within %.3f px (32-row means), shear %.5f px/row "
+      "(closed form %.5f)\n",
+      stage.last_rolling_bands(), largest_window_error(got, want, 32), shear,
+      closed_form * (1 + std::pow(east / north, 2)));
 }
 
 TEST(CameraTiming, RollingShutterShiftsRowsByTheirOwnTranslation) {
@@ -208,10 +209,11 @@ TEST(CameraTiming, RollingShutterShiftsRowsByTheirOwnTranslation) {
   const double per_row = cam.line_delay_us * 1e-6 * v * cam.fx_px / north;
   EXPECT_NEAR(line_fit(got).second, kLean - per_row, 0.02 * per_row);
   EXPECT_NEAR(line_fit(got).first, cam.cx_px + cam.fx_px * east / north, 0.05);
-  std::printf("[ measured ] translation: %d bands, edge within %.3f px (32-row means), %.5f px/row "
-              "(closed form %.5f)\n",
-              stage.last_rolling_bands(), largest_window_error(got, want, 32),
-              kLean - line_fit(got).second, per_row);
+  std::printf(
+      "[ measured ] translation: %d bands, edge within %.3f px (32-row means), %.5f px/row "
+      "(closed form %.5f)\n",
+      stage.last_rolling_bands(), largest_window_error(got, want, 32), kLean - line_fit(got).second,
+      per_row);
 }
 
 TEST(CameraTiming, AnUnsynchronisedRightImageSeesTheRigWhereItIsAtItsOwnTime) {
