@@ -29,9 +29,10 @@ std::string one_of(const std::string& name, const std::vector<std::string>& name
 
 DatasetCommands::DatasetCommands(CLI::App& app) {
   export_ = app.add_subcommand(
-      "export", "Render a scenario into a dataset other tools read (KITTI, EuRoC, TUM RGB-D)");
+      "export",
+      "Render a scenario into a dataset other tools read (KITTI, EuRoC, TUM RGB-D, ROS 1 bag)");
   export_->add_option("SCENARIO", scenario_, "Scenario YAML file")->required();
-  export_->add_option("--format", format_, "Dataset layout: kitti, euroc or tum-rgbd")
+  export_->add_option("--format", format_, "Dataset layout: kitti, euroc, tum-rgbd or rosbag")
       ->capture_default_str();
   export_->add_option("--out", out_, "Output folder (written atomically)")->required();
   export_->add_option("--sequence", sequence_, "KITTI sequence number")->capture_default_str();
@@ -43,9 +44,17 @@ DatasetCommands::DatasetCommands(CLI::App& app) {
   add_frame_cache_option(export_);
 
   vo_ = app.add_subcommand(
-      "vo", "Run the built-in VOs on a KITTI or EuRoC stereo dataset and evaluate them");
-  vo_->add_option("DATASET", dataset_, "Dataset folder")->required();
-  vo_->add_option("--format", format_, "Dataset layout: kitti or euroc")->capture_default_str();
+      "vo", "Run the built-in VOs on a KITTI, EuRoC or ROS 1 bag stereo dataset and evaluate them");
+  vo_->add_option("DATASET", dataset_, "Dataset folder, or a ROS 1 bag (a .bag file)")->required();
+  vo_->add_option("--format", format_, "Dataset layout: kitti, euroc or rosbag")
+      ->capture_default_str();
+  vo_->add_option("--gt-topic", gt_topic_,
+                  "rosbag: the ground truth's topic (PoseStamped, TransformStamped or Odometry of "
+                  "the IMU; default: /groundtruth/pose, else EuRoC's "
+                  "/vicon/firefly_sbx/firefly_sbx)");
+  vo_->add_option("--calibration", calibration_,
+                  "rosbag: a Kalibr camera chain (default: kalibr_imucam_chain.yaml beside the "
+                  "bag)");
   vo_->add_option("--algo", algos_, "VO algorithms (default: the settings' pipeline.vo)")
       ->delimiter(',')
       ->check(CLI::Validator(
@@ -120,6 +129,8 @@ int DatasetCommands::run_vo() {
       as_usage_error("--format", [&] { return dataset::format_from_name(format_); });
   dataset::ReadOptions read;
   read.sequence = sequence_;
+  read.gt_topic = gt_topic_;
+  read.calibration = calibration_;
   const dataset::StereoDataset data = dataset::read_dataset(dataset_, format, read);
   pipeline::DatasetRunOptions o;
   o.fusion_on_command_line = !fusion_.empty();

@@ -28,7 +28,7 @@ class DatasetCommands {
   std::vector<std::string> sets_;
   int frames_ = 0;
   bool force_ = false;
-  std::string dataset_, settings_;
+  std::string dataset_, settings_, gt_topic_, calibration_;
   std::vector<std::string> algos_;
   std::vector<std::string> fusion_;
 };

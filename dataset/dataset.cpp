@@ -25,8 +25,9 @@ DatasetFormat format_from_name(std::string_view name) {
   if (lower == "kitti") return DatasetFormat::kKitti;
   if (lower == "euroc") return DatasetFormat::kEuroc;
   if (lower == "tum-rgbd") return DatasetFormat::kTumRgbd;
+  if (lower == "rosbag") return DatasetFormat::kRosbag;
   throw UserError(fmt::format(
-      "unknown dataset format: got '{}', expected one of: kitti, euroc, tum-rgbd", name));
+      "unknown dataset format: got '{}', expected one of: kitti, euroc, tum-rgbd, rosbag", name));
 }
 
 std::string_view format_name(DatasetFormat format) {
@@ -37,6 +38,8 @@ std::string_view format_name(DatasetFormat format) {
       return "euroc";
     case DatasetFormat::kTumRgbd:
       return "tum-rgbd";
+    case DatasetFormat::kRosbag:
+      return "rosbag";
   }
   return "?";
 }
@@ -50,11 +53,14 @@ std::unique_ptr<DatasetWriter> make_writer(DatasetFormat format, const fs::path&
       return detail::make_euroc_writer(root, calibration);
     case DatasetFormat::kTumRgbd:
       return detail::make_tum_rgbd_writer(root, calibration);
+    case DatasetFormat::kRosbag:
+      return detail::make_rosbag_writer(root, calibration);
   }
   return nullptr;
 }
 
 StereoDataset read_dataset(const fs::path& root, DatasetFormat format, const ReadOptions& options) {
+  if (format == DatasetFormat::kRosbag) return detail::read_rosbag(root, options);
   if (!fs::is_directory(root))
     throw UserError(fmt::format("{}: no such dataset folder", root.string()));
   switch (format) {
@@ -64,8 +70,11 @@ StereoDataset read_dataset(const fs::path& root, DatasetFormat format, const Rea
       return detail::read_euroc(root);
     case DatasetFormat::kTumRgbd:
       throw UserError(
-          fmt::format("{}: a TUM RGB-D dataset has one camera; the stereo VOs read kitti or euroc",
+          fmt::format("{}: a TUM RGB-D dataset has one camera; the stereo VOs read kitti, euroc "
+                      "or rosbag",
                       root.string()));
+    case DatasetFormat::kRosbag:
+      break;
   }
   return {};
 }
@@ -83,7 +92,11 @@ cv::Mat read_gray(const fs::path& path) {
 }
 
 std::pair<cv::Mat, cv::Mat> read_pair(const StereoDataset& data, const DatasetFrame& frame) {
-  cv::Mat left = read_gray(frame.left), right = read_gray(frame.right);
+  cv::Mat left, right;
+  if (data.images)
+    std::tie(left, right) = data.images->read(frame);
+  else
+    left = read_gray(frame.left), right = read_gray(frame.right);
   if (!data.rectification) return {left, right};
   const Rectification& r = *data.rectification;
   cv::Mat left_rect, right_rect;
@@ -120,6 +133,9 @@ std::vector<CompassReading> read_compass_csv(const fs::path& path) {
       throw UserError(fmt::format("{}:{}: heading: got {}, expected degrees in [0, 360)",
                                   path.string(), line.number, cells[1]));
     r.heading_rad = wrap_angle_rad(deg2rad(deg));
+    for (int i = 0; i < 3; ++i)
+      r.field_S_nt[i] =
+          detail::parse_number(cells[2 + i], path, line.number, fmt::format("m_S_{}", "xyz"[i]));
     if (!out.empty() && r.t_ns <= out.back().t_ns)
       throw UserError(
           fmt::format("{}:{}: timestamp: got {}, expected more than the line before's {}",

@@ -15,6 +15,10 @@
 //    state_groundtruth_estimate0/data.csv (body pose in the world, velocity).
 //  - TUM RGB-D (Sturm et al. 2012): rgb/<t>.png, depth/<t>.png (16 bit, 5000 per metre, 0 =
 //    no depth), rgb.txt, depth.txt, groundtruth.txt (left camera pose, TUM format).
+//  - ROS 1 bag v2.0 (written and read with Debian's rosbag_storage): EuRoC's topic names
+//    (/cam0/image_raw, /cam1/image_raw mono8, /imu0), camera_info, /gps/fix, /mag,
+//    /compass/heading, /groundtruth/pose and /tf_static, with Kalibr's and VINS-Fusion's
+//    calibration files beside the bag (rosbag.hpp says which frame is which).
 #pragma once
 
 #include <filesystem>
@@ -50,12 +54,17 @@ struct ImuNoiseModel {
 struct CompassReading {
   TimeNs t_ns = 0;
   double heading_rad = 0;
+  Vec3 field_S_nt = Vec3::Zero();  ///< measured field in the compass frame [nT]
 };
 
 /// What a writer needs besides the frames.
 struct ExportCalibration {
-  StereoRig rig;  ///< the rectified pair the images are in
-  SE3 T_S_C;      ///< left camera in the body frame (EuRoC: the IMU's)
+  StereoRig rig;             ///< the rectified pair the images are in
+  SE3 T_S_C;                 ///< left camera in the body frame (EuRoC: the IMU's)
+  SE3 T_B_S;                 ///< the IMU in the vessel's body frame (FRD at the centre of gravity)
+  std::optional<SE3> T_B_M;  ///< the compass in the vessel's body frame, when it has one
+  std::optional<Vec3> p_B_gps;  ///< the GPS antenna in the vessel's body frame, when it has one
+  double gps_sigma_horizontal_m = 0;  ///< the GPS's horizontal RMS is this times HDOP
   double camera_rate_hz = 0;
   ImuNoiseModel imu;
   std::string sequence = "00";  ///< KITTI sequence number
@@ -99,7 +108,16 @@ std::unique_ptr<DatasetWriter> make_writer(DatasetFormat format, const std::file
 /// One stereo pair of a dataset: where its images are and when they were taken.
 struct DatasetFrame {
   TimeNs t_ns = 0;
-  std::filesystem::path left, right;
+  std::filesystem::path left, right;  ///< image files (empty when the images are in a bag)
+  TimeNs left_record_ns = 0, right_record_ns = 0;  ///< a bag's record times of the two images
+};
+
+/// Where a dataset's images are when they are not files of their own (a bag's messages).
+class ImageSource {
+ public:
+  virtual ~ImageSource() = default;
+  /// The raw pair of `frame`, 8-bit gray; UserError naming the container and topic otherwise.
+  virtual std::pair<cv::Mat, cv::Mat> read(const DatasetFrame& frame) const = 0;
 };
 
 /// Pixel maps (cv::remap) from raw images to the rectified pair of a StereoDataset's rig.
@@ -125,13 +143,22 @@ struct StereoDataset {
   /// pair is rectified as it is read (read_pair) with OpenCV's stereoRectify (zero disparity
   /// at infinity, no black border: alpha 0).
   std::shared_ptr<const Rectification> rectification;
+  /// Set when the images are messages in a container (a bag): read_pair reads them there.
+  std::shared_ptr<const ImageSource> images;
 };
 
 struct ReadOptions {
   std::string sequence = "00";  ///< KITTI: sequences/NN under the root
+  /// ROS bags: the ground truth's topic (geometry_msgs PoseStamped, TransformStamped or
+  /// nav_msgs/Odometry, the IMU's pose in the world); empty: the first of /groundtruth/pose
+  /// (driftlab's) and /vicon/firefly_sbx/firefly_sbx (EuRoC's Vicon room) in the bag.
+  std::string gt_topic;
+  /// ROS bags: a Kalibr camera chain (kalibr_imucam_chain.yaml); empty: the one beside the bag.
+  std::filesystem::path calibration;
 };
 
-/// Reads a dataset's index, calibration and ground truth (not the images). Strict: a missing
+/// Reads a dataset's index, calibration and ground truth (not the images). `root` is a folder,
+/// or for kRosbag a .bag file (or a folder holding one). Strict: a missing
 /// file, a malformed line or a pair that is not rectified throws UserError naming the file.
 StereoDataset read_dataset(const std::filesystem::path& root, DatasetFormat format,
                            const ReadOptions& options = {});

@@ -1,11 +1,13 @@
 // Helpers shared by the format files of dataset/ (not part of its interface).
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include <yaml-cpp/yaml.h>
 #include <opencv2/core.hpp>
 
 #include "core/se3.hpp"
@@ -35,6 +37,51 @@ std::string matrix_text(const Eigen::MatrixXd& m, std::string_view sep);
 Eigen::Matrix<double, 3, 4> matrix_3x4(const SE3& T);
 Eigen::Matrix4d matrix_4x4(const SE3& T);
 
+/// One camera of a calibration file (EuRoC's sensor.yaml, a Kalibr camera chain).
+struct CameraCalibration {
+  PinholeCamera camera;
+  std::string distortion_model;    ///< radial-tangential (radtan, plumb_bob) or empty
+  std::vector<double> distortion;  ///< k1, k2, p1, p2 [, k3]
+  SE3 T_B_C;                       ///< the camera in the body (IMU) frame
+};
+
+/// The rectified pair of two calibrated cameras (OpenCV's stereoRectify, zero disparity at
+/// infinity, alpha 0), or the pair as it is when it is already rectified.
+struct RectifiedPair {
+  StereoRig rig;
+  SE3 T_C0_Crect;  ///< the rectified left camera in the raw left one (a rotation)
+  std::shared_ptr<const Rectification> rectification;  ///< null: already rectified
+};
+/// UserError naming `cam1_file` when cam1 is not a second camera to the right of cam0.
+RectifiedPair rectify_pair(const CameraCalibration& c0, const CameraCalibration& c1,
+                           const std::filesystem::path& cam1_file);
+
+/// A list of `count` finite numbers (any count when 0) under `key` of the mapping `root`.
+/// `prefix` goes before the key in messages (Kalibr's "cam0.").
+std::vector<double> yaml_numbers(const YAML::Node& root, const char* key, std::size_t count,
+                                 const std::filesystem::path& path, std::string_view prefix = {});
+/// A camera under Kalibr's keys as EuRoC's sensor.yaml names them (intrinsics, resolution,
+/// distortion_model, distortion_coefficients), without its pose; UserError naming `path`.
+CameraCalibration camera_from_keys(const YAML::Node& root, const std::filesystem::path& path,
+                                   std::string_view prefix);
+/// The IMU's Kalibr noise model under EuRoC's keys (rate_hz and the four densities).
+ImuNoiseModel imu_noise_from_keys(const YAML::Node& root, const std::filesystem::path& path,
+                                  std::string_view prefix);
+
+// Kalibr's and VINS-Fusion's calibration files (kalibr.cpp).
+std::string kalibr_imucam_chain_yaml(const ExportCalibration& calibration);
+std::string kalibr_imu_chain_yaml(const ImuNoiseModel& imu);
+/// VINS-Fusion's stereo + IMU configuration and its two camera files: (name, text).
+std::vector<std::pair<std::string, std::string>> vins_fusion_files(
+    const ExportCalibration& calibration);
+/// A Kalibr camera chain's two cameras (pinhole, radtan) and their topics.
+struct KalibrChain {
+  std::array<CameraCalibration, 2> cameras;
+  std::array<std::string, 2> topics;  ///< rostopic; empty when the file names none
+};
+KalibrChain read_kalibr_camchain(const std::filesystem::path& path);
+ImuNoiseModel read_kalibr_imu_chain(const std::filesystem::path& path);
+
 /// Moves `from` to `to`, creating to's parent.
 void move_file(const std::filesystem::path& from, const std::filesystem::path& to);
 
@@ -45,6 +92,9 @@ std::unique_ptr<DatasetWriter> make_euroc_writer(const std::filesystem::path& ro
                                                  const ExportCalibration& calibration);
 std::unique_ptr<DatasetWriter> make_tum_rgbd_writer(const std::filesystem::path& root,
                                                     const ExportCalibration& calibration);
+std::unique_ptr<DatasetWriter> make_rosbag_writer(const std::filesystem::path& root,
+                                                  const ExportCalibration& calibration);
+StereoDataset read_rosbag(const std::filesystem::path& path, const ReadOptions& options);
 StereoDataset read_kitti(const std::filesystem::path& root, const ReadOptions& options);
 StereoDataset read_euroc(const std::filesystem::path& root);
 

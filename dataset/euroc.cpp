@@ -139,60 +139,82 @@ class EurocWriter final : public DatasetWriter {
 
 // --- Reading.
 
-struct CameraYaml {
-  PinholeCamera camera;
-  std::string distortion_model;
-  std::vector<double> distortion;
-  SE3 T_B_C;
-};
+using CameraYaml = CameraCalibration;
 
-// A list of `count` finite numbers (any count when 0) under `key` of the mapping `root`.
+}  // namespace
+
 std::vector<double> yaml_numbers(const YAML::Node& root, const char* key, std::size_t count,
-                                 const fs::path& path) {
+                                 const fs::path& path, std::string_view prefix) {
   const YAML::Node node = root.IsMap() ? root[key] : YAML::Node();
   if (!node || !node.IsSequence() || (count && node.size() != count))
-    throw UserError(fmt::format("{}: {}: expected a list of {} numbers", path.string(), key,
-                                count ? std::to_string(count) : "some"));
+    throw UserError(fmt::format("{}: {}{}: expected a list of {} numbers", path.string(), prefix,
+                                key, count ? std::to_string(count) : "some"));
   std::vector<double> out;
   for (const auto& v : node) {
     double x = std::numeric_limits<double>::quiet_NaN();
     if (v.IsScalar()) yaml::parse_double(v.Scalar(), &x);
     if (!std::isfinite(x))
-      throw UserError(fmt::format("{}:{}: {}: got '{}', expected a finite number", path.string(),
-                                  v.Mark().line + 1, key, v.IsScalar() ? v.Scalar() : "a list"));
+      throw UserError(fmt::format("{}:{}: {}{}: got '{}', expected a finite number", path.string(),
+                                  v.Mark().line + 1, prefix, key,
+                                  v.IsScalar() ? v.Scalar() : "a list"));
     out.push_back(x);
   }
   return out;
 }
 
-// Kalibr's camera keys: intrinsics (fu, fv, cu, cv), resolution, distortion, T_BS.
-CameraYaml camera_from_yaml(const YAML::Node& root, const fs::path& path) {
-  if (!root.IsMap())
-    throw UserError(path.string() + ": expected a mapping of keys (intrinsics, resolution, T_BS)");
-  CameraYaml c;
-  const auto k = yaml_numbers(root, "intrinsics", 4, path);
-  const auto res = yaml_numbers(root, "resolution", 2, path);
+CameraCalibration camera_from_keys(const YAML::Node& root, const fs::path& path,
+                                   std::string_view prefix) {
+  CameraCalibration c;
+  const auto k = yaml_numbers(root, "intrinsics", 4, path, prefix);
+  const auto res = yaml_numbers(root, "resolution", 2, path, prefix);
   if (!(k[0] > 0 && k[1] > 0))
-    throw UserError(fmt::format("{}: intrinsics: got fu {} and fv {}, expected both > 0",
-                                path.string(), k[0], k[1]));
+    throw UserError(fmt::format("{}: {}intrinsics: got fu {} and fv {}, expected both > 0",
+                                path.string(), prefix, k[0], k[1]));
   for (double r : res)
     if (!(r >= 1 && r <= 16384 && r == std::floor(r)))
-      throw UserError(
-          fmt::format("{}: resolution: got {} x {}, expected whole numbers of pixels in [1, 16384]",
-                      path.string(), res[0], res[1]));
+      throw UserError(fmt::format(
+          "{}: {}resolution: got {} x {}, expected whole numbers of pixels in [1, 16384]",
+          path.string(), prefix, res[0], res[1]));
   c.camera = {k[0], k[1], k[2], k[3], static_cast<int>(res[0]), static_cast<int>(res[1])};
   if (root["distortion_coefficients"])
-    c.distortion = yaml_numbers(root, "distortion_coefficients", 0, path);
+    c.distortion = yaml_numbers(root, "distortion_coefficients", 0, path, prefix);
   if (root["distortion_model"])
     c.distortion_model =
         root["distortion_model"].IsScalar() ? root["distortion_model"].Scalar() : "(not a name)";
   const bool radtan = c.distortion_model.empty() || c.distortion_model == "radial-tangential" ||
-                      c.distortion_model == "radtan";
+                      c.distortion_model == "radtan" || c.distortion_model == "plumb_bob";
   if (!radtan || (c.distortion.size() != 0 && c.distortion.size() != 4 && c.distortion.size() != 5))
     throw UserError(fmt::format(
-        "{}: distortion_model: got '{}' with {} coefficients, expected radial-tangential with 4 "
+        "{}: {}distortion_model: got '{}' with {} coefficients, expected radial-tangential with 4 "
         "(k1, k2, p1, p2) or 5",
-        path.string(), c.distortion_model, c.distortion.size()));
+        path.string(), prefix, c.distortion_model, c.distortion.size()));
+  return c;
+}
+
+ImuNoiseModel imu_noise_from_keys(const YAML::Node& root, const fs::path& path,
+                                  std::string_view prefix) {
+  const auto number = [&](const char* key) {
+    const YAML::Node n = root.IsMap() ? root[key] : YAML::Node();
+    double x = std::numeric_limits<double>::quiet_NaN();
+    if (n && n.IsScalar()) yaml::parse_double(n.Scalar(), &x);
+    if (!(std::isfinite(x) && x > 0))
+      throw UserError(fmt::format("{}{}: {}{}: got '{}', expected a number > 0", path.string(),
+                                  n ? fmt::format(":{}", n.Mark().line + 1) : "", prefix, key,
+                                  n && n.IsScalar() ? n.Scalar() : "nothing"));
+    return x;
+  };
+  return {number("rate_hz"), number("gyroscope_noise_density"), number("gyroscope_random_walk"),
+          number("accelerometer_noise_density"), number("accelerometer_random_walk")};
+}
+
+namespace {
+
+// EuRoC's camera keys (Kalibr's names): intrinsics (fu, fv, cu, cv), resolution, distortion,
+// T_BS.
+CameraYaml camera_from_yaml(const YAML::Node& root, const fs::path& path) {
+  if (!root.IsMap())
+    throw UserError(path.string() + ": expected a mapping of keys (intrinsics, resolution, T_BS)");
+  CameraYaml c = camera_from_keys(root, path, "");
   const auto t = yaml_numbers(root["T_BS"] ? root["T_BS"] : YAML::Node(), "data", 16, path);
   Mat3 R;
   R << t[0], t[1], t[2], t[4], t[5], t[6], t[8], t[9], t[10];
@@ -207,19 +229,7 @@ CameraYaml camera_from_yaml(const YAML::Node& root, const fs::path& path) {
 ImuNoiseModel read_imu_yaml(const fs::path& path) {
   const std::string text = read_text_file(path, "EuRoC sensor.yaml");
   try {
-    const YAML::Node root = YAML::Load(text);
-    const auto number = [&](const char* key) {
-      const YAML::Node n = root.IsMap() ? root[key] : YAML::Node();
-      double x = std::numeric_limits<double>::quiet_NaN();
-      if (n && n.IsScalar()) yaml::parse_double(n.Scalar(), &x);
-      if (!(std::isfinite(x) && x > 0))
-        throw UserError(fmt::format("{}{}: {}: got '{}', expected a number > 0", path.string(),
-                                    n ? fmt::format(":{}", n.Mark().line + 1) : "", key,
-                                    n && n.IsScalar() ? n.Scalar() : "nothing"));
-      return x;
-    };
-    return {number("rate_hz"), number("gyroscope_noise_density"), number("gyroscope_random_walk"),
-            number("accelerometer_noise_density"), number("accelerometer_random_walk")};
+    return imu_noise_from_keys(YAML::Load(text), path, "");
   } catch (const YAML::Exception& e) {
     throw UserError(fmt::format("{}:{}: {}", path.string(), e.mark.line + 1, e.msg));
   }
@@ -272,11 +282,7 @@ cv::Matx33d camera_matrix(const PinholeCamera& c) {
   return {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1};
 }
 
-struct RectifiedPair {
-  StereoRig rig;
-  SE3 T_C0_Crect;  // the rectified left camera in the raw left one (a rotation)
-  std::shared_ptr<const Rectification> rectification;  // null: already rectified
-};
+}  // namespace
 
 RectifiedPair rectify_pair(const CameraYaml& c0, const CameraYaml& c1, const fs::path& cam1_yaml) {
   RectifiedPair out;
@@ -327,8 +333,6 @@ RectifiedPair rectify_pair(const CameraYaml& c0, const CameraYaml& c1, const fs:
   out.T_C0_Crect = SE3(Mat3(R1e.transpose()), Vec3::Zero());
   return out;
 }
-
-}  // namespace
 
 std::unique_ptr<DatasetWriter> make_euroc_writer(const fs::path& root,
                                                  const ExportCalibration& calibration) {

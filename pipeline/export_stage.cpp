@@ -11,6 +11,7 @@
 #include "pipeline/render_stage.hpp"
 #include "pipeline/run.hpp"
 #include "pipeline/sensor_stage.hpp"
+#include "sim/sensors/clock.hpp"
 
 namespace driftlab::pipeline {
 namespace fs = std::filesystem;
@@ -28,6 +29,14 @@ dataset::ExportCalibration export_calibration(const Scenario& sc) {
   dataset::ExportCalibration cal;
   cal.rig = rig_of(sc.sensors.camera);
   cal.T_S_C = imu_mount_T_B_S(sc).inverse() * camera_mount_T_B_C(sc.sensors.camera.mount);
+  cal.T_B_S = imu_mount_T_B_S(sc);
+  if (sc.sensors.compass.enabled)
+    cal.T_B_M = sim::SensorMount::from_options(sc.sensors.compass.mount).T_B_S();
+  if (sc.sensors.gps.enabled) {
+    const auto& a = sc.sensors.gps.antenna_frd_m;
+    cal.p_B_gps = Vec3(a[0], a[1], a[2]);
+    cal.gps_sigma_horizontal_m = sc.sensors.gps.sigma_horizontal_m;
+  }
   cal.camera_rate_hz = sc.sensors.camera.rate_hz;
   const auto& imu = sc.sensors.imu;
   if (imu.enabled)
@@ -54,7 +63,7 @@ ExportSummary export_dataset(const Scenario& sc, const fs::path& out_dir,
   SensorStage sensors(sc, staging);
   dataset::ExportTruth truth;
   MissionTruth mission =
-      simulate_mission(sc, nullptr, &sensors, options.format == dataset::DatasetFormat::kEuroc);
+      simulate_mission(sc, nullptr, &sensors, dataset::wants_body_truth(options.format));
   truth.body = std::move(mission.imu_states);
   if (mission.camera_gt.empty()) throw UserError("scenario '" + sc.name + "': no camera frames");
   const sim::SceneGeometry scene = scene_for_track(sc, mission.camera_gt);

@@ -605,9 +605,9 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
   body.write(body_csv_header());
   const auto t_physics = SteadyClock::now();
   SensorStage sensors(sc, dir.path());
-  bool euroc_export = false;  // an external VO reads EuRoC: keep the IMU's true states
+  bool euroc_export = false;  // an external VO reads EuRoC or a bag: keep the IMU's true states
   for (const auto& e : sc.pipeline.external_vo)
-    euroc_export = euroc_export || e.format == dataset::DatasetFormat::kEuroc;
+    euroc_export = euroc_export || dataset::wants_body_truth(e.format);
   MissionTruth truth = simulate_mission(
       sc, [&](const sim::BodySample& b) { body.write(body_csv_row(b)); }, &sensors, euroc_export);
   summary.motion = truth.motion;

@@ -230,7 +230,10 @@ TEST(DatasetReaders, NameTheFileLineAndExpectation) {
   std::ofstream(calib) << "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nP1: 1 0 0 0 0 1 0 0 0 0 1 0\n";
   e = error_of([&] { read_dataset(root, DatasetFormat::kKitti); });
   EXPECT_NE(e.find("not a rectified pair"), std::string::npos) << e;
-  e = error_of([&] { read_dataset(root, DatasetFormat::kKitti, {"07"}); });
+  e = error_of([&] {
+    read_dataset(root, DatasetFormat::kKitti,
+                 {.sequence = "07", .gt_topic = {}, .calibration = {}});
+  });
   EXPECT_NE(e.find("expected sequences/07/"), std::string::npos) << e;
   e = error_of([&] { read_dataset(root / "nowhere", DatasetFormat::kEuroc); });
   EXPECT_NE(e.find("no such dataset folder"), std::string::npos) << e;
