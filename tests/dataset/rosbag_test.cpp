@@ -1,0 +1,379 @@
+// ROS 1 bags: the writer against ROS's own Python reader (python3-rosbag, independent of the C++
+// library that writes), the reader against the writer and against a bag written by ROS's Python
+// writer in EuRoC's layout, whose images are also an EuRoC folder.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/process.hpp"
+#include "core/rotation.hpp"
+#include "core/trajectory_io.hpp"
+#include "dataset/dataset.hpp"
+#include "dataset/rosbag.hpp"
+#include "tests/support/test_support.hpp"
+
+namespace driftlab::dataset {
+namespace {
+
+namespace fs = std::filesystem;
+using test::slurp;
+using nlohmann::json;
+
+const fs::path kTests = fs::path(DRIFTLAB_SOURCE_DIR) / "tests" / "dataset";
+
+// Runs one of the tests' Python scripts with Debian's interpreter (the one python3-rosbag is
+// installed for); its standard output.
+std::string python(const std::string& script, const std::vector<std::string>& args,
+                   const fs::path& output) {
+  ProcessSpec spec;
+  spec.executable = "/usr/bin/python3";
+  spec.args = {(kTests / script).string()};
+  spec.args.insert(spec.args.end(), args.begin(), args.end());
+  spec.output_file = output;
+  const ExitStatus status = wait_process(spawn_process(spec));
+  EXPECT_TRUE(status.ok()) << script << ": " << status.describe() << "\n" << slurp(output);
+  return slurp(output);
+}
+
+ExportCalibration calibration() {
+  ExportCalibration cal;
+  cal.rig.camera = {480, 470, 40.5, 30.25, 80, 60};
+  cal.rig.baseline_m = 0.25;
+  cal.T_S_C = SE3(quat_from_euler_zyx({0.1, -0.2, 0.3}), Vec3(0.5, -0.1, 0.2));
+  cal.T_B_S = SE3(quat_from_euler_zyx({0, 0, 0.05}), Vec3(1, 0, -0.5));  // yaw 0.05 rad
+  cal.T_B_M = SE3(Quat::Identity(), Vec3(-2, 0, -1));
+  cal.p_B_gps = Vec3(0, 0.5, -3);
+  cal.gps_sigma_horizontal_m = 1.5;
+  cal.camera_rate_hz = 10;
+  cal.imu = {200, 1.7e-4, 2e-5, 2e-3, 3e-3};
+  cal.source = "test";
+  return cal;
+}
+
+// Three frames (the first stamped 0), IMU, GPS (a fix and none), compass and the IMU's truth.
+struct Sequence {
+  std::vector<TimeNs> stamps{0, 100'000'123, 200'000'000};
+  std::vector<cv::Mat> left, right;
+  std::vector<ImuSample> imu;
+  ExportTruth truth;
+  explicit Sequence(const fs::path& staging) {
+    cv::RNG rng(7);
+    for (std::size_t i = 0; i < stamps.size(); ++i) {
+      cv::Mat l(60, 80, CV_8UC1), r(60, 80, CV_8UC1);
+      rng.fill(l, cv::RNG::UNIFORM, 0, 256);
+      rng.fill(r, cv::RNG::UNIFORM, 0, 256);
+      left.push_back(l);
+      right.push_back(r);
+    }
+    for (int k = 0; k < 41; ++k) {
+      const TimeNs t = k * 5'000'000;
+      imu.push_back({t, Vec3(0.01 * k, -0.2, 1.0 / 3), Vec3(0.1, 0.7 * k, -9.81)});
+      const SE3 T_W_S(quat_from_euler_zyx({0.01 * k, 0.02, 0.5}), Vec3(3 + 0.1 * k, k, -1));
+      truth.body.push_back({t, T_W_S, Vec3(1, 0, 0), {}});
+    }
+    fs::create_directories(staging);
+    write_euroc_imu(staging / "imu.csv", imu);
+    write_file_atomic(staging / "gps.csv",
+                     "#timestamp [ns],fix [0/1],satellites [],hdop [],north [m],east [m],down "
+                     "[m],latitude [deg],longitude [deg],height [m]\n"
+                     "0,1,7,1.25,1,2,3,52.5,-0.25,17.5\n"
+                     "100000000,0,2,nan,nan,nan,nan,nan,nan,nan\n");
+    write_file_atomic(staging / "compass.csv",
+                     "#timestamp [ns],heading [deg],m_S_x [nT],m_S_y [nT],m_S_z [nT]\n"
+                     "50000000,30,17000,-1500,46000\n"
+                     "150000000,350.5,16000,2500,45000\n");
+    truth.sensor_csvs = {staging / "imu.csv", staging / "gps.csv", staging / "compass.csv"};
+  }
+  void write(DatasetWriter& w) const {
+    for (std::size_t i = 0; i < stamps.size(); ++i) w.add_frame(stamps[i], left[i], right[i], {});
+    w.finish(truth);
+  }
+};
+
+std::vector<json> messages_on(const json& bag, const std::string& topic) {
+  std::vector<json> out;
+  for (const json& m : bag["messages"])
+    if (m["topic"] == topic) out.push_back(m);
+  return out;
+}
+
+std::vector<int> bytes_of(const cv::Mat& image) {
+  return std::vector<int>(image.datastart, image.dataend);
+}
+
+Quat quat_of(const json& q) { return Quat(q[0], q[1], q[2], q[3]); }
+
+TEST(RosbagExport, PythonsRosbagReadsEveryMessageWithItsStampsAndValues) {
+  const fs::path root = test::fresh_temp_dir("rosbag_export");
+  const Sequence seq(root / "staging");
+  seq.write(*make_writer(DatasetFormat::kRosbag, root, calibration()));
+  const json bag = json::parse(
+      python("read_bag.py", {(root / rosbag_names::kBagFile).string()}, root / "bag.json"));
+  EXPECT_EQ(bag["version"], 200);
+  const std::map<std::string, std::pair<std::string, int>> expected_topics = {
+      {"/cam0/image_raw", {"sensor_msgs/Image", 3}},
+      {"/cam1/image_raw", {"sensor_msgs/Image", 3}},
+      {"/cam0/camera_info", {"sensor_msgs/CameraInfo", 3}},
+      {"/cam1/camera_info", {"sensor_msgs/CameraInfo", 3}},
+      {"/imu0", {"sensor_msgs/Imu", 41}},
+      {"/gps/fix", {"sensor_msgs/NavSatFix", 2}},
+      {"/mag", {"sensor_msgs/MagneticField", 2}},
+      {"/compass/heading", {"geometry_msgs/QuaternionStamped", 2}},
+      {"/groundtruth/pose", {"geometry_msgs/PoseStamped", 41}},
+      {"/tf_static", {"tf2_msgs/TFMessage", 1}}};
+  EXPECT_EQ(bag["topics"].size(), expected_topics.size());
+  for (const auto& [topic, type_count] : expected_topics) {
+    ASSERT_TRUE(bag["topics"].contains(topic)) << topic;
+    EXPECT_EQ(bag["topics"][topic]["type"], type_count.first) << topic;
+    EXPECT_EQ(bag["topics"][topic]["count"], type_count.second) << topic;
+    EXPECT_EQ(bag["topics"][topic]["latching"], topic == "/tf_static" ? "1" : "0") << topic;
+  }
+  // Images: stamps, sizes and every byte; a message stamped 0 is recorded at 1 ns.
+  for (int cam = 0; cam < 2; ++cam) {
+    const auto images = messages_on(bag, rosbag_names::kImage[cam]);
+    const auto infos = messages_on(bag, rosbag_names::kCameraInfo[cam]);
+    ASSERT_EQ(images.size(), 3u);
+    for (std::size_t i = 0; i < 3; ++i) {
+      const json& m = images[i];
+      EXPECT_EQ(m["stamp_ns"], seq.stamps[i]);
+      EXPECT_EQ(m["record_ns"], std::max<TimeNs>(seq.stamps[i], 1));
+      EXPECT_EQ(m["seq"], i);
+      EXPECT_EQ(m["frame_id"], rosbag_names::kOpticalFrame[cam]);
+      EXPECT_EQ(m["encoding"], "mono8");
+      EXPECT_EQ(m["width"], 80);
+      EXPECT_EQ(m["height"], 60);
+      EXPECT_EQ(m["step"], 80);
+      EXPECT_EQ(m["data"].get<std::vector<int>>(),
+                bytes_of(cam == 0 ? seq.left[i] : seq.right[i]));
+      // camera_info: P = K [I | (-B, 0, 0)] (cam1's Tx = -fx B = -120), no distortion.
+      EXPECT_EQ(infos[i]["stamp_ns"], seq.stamps[i]);
+      EXPECT_EQ(infos[i]["P"].get<std::vector<double>>(),
+                (std::vector<double>{480, 0, 40.5, cam == 0 ? 0.0 : -120.0, 0, 470, 30.25, 0, 0,
+                                     0, 1, 0}));
+      EXPECT_EQ(infos[i]["D"].get<std::vector<double>>(), std::vector<double>(5, 0.0));
+    }
+  }
+  // IMU: values exactly, covariance density^2 x rate, no orientation.
+  const auto imu = messages_on(bag, "/imu0");
+  ASSERT_EQ(imu.size(), seq.imu.size());
+  for (std::size_t k = 0; k < imu.size(); ++k) {
+    EXPECT_EQ(imu[k]["stamp_ns"], seq.imu[k].t_ns);
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_EQ(imu[k]["w"][a].get<double>(), seq.imu[k].gyro_rad_s[a]);
+      EXPECT_EQ(imu[k]["a"][a].get<double>(), seq.imu[k].accel_m_s2[a]);
+    }
+    EXPECT_EQ(imu[k]["q_cov0"], -1.0);
+    EXPECT_DOUBLE_EQ(imu[k]["w_cov"][4].get<double>(), 1.7e-4 * 1.7e-4 * 200);
+    EXPECT_DOUBLE_EQ(imu[k]["a_cov"][8].get<double>(), 2e-3 * 2e-3 * 200);
+  }
+  // GPS: a fix with covariance from HDOP (sigma 1.5 m x HDOP 1.25: 1.875 m horizontal RMS),
+  // then no fix.
+  const auto gps = messages_on(bag, "/gps/fix");
+  ASSERT_EQ(gps.size(), 2u);
+  EXPECT_EQ(gps[0]["status"], 0);
+  EXPECT_EQ(gps[0]["service"], 1);
+  EXPECT_EQ(gps[0]["lla"].get<std::vector<double>>(), (std::vector<double>{52.5, -0.25, 17.5}));
+  EXPECT_DOUBLE_EQ(gps[0]["cov"][0].get<double>(), 1.875 * 1.875 / 2);
+  EXPECT_DOUBLE_EQ(gps[0]["cov"][4].get<double>(), 1.875 * 1.875 / 2);
+  EXPECT_EQ(gps[0]["cov_type"], 1);
+  EXPECT_EQ(gps[1]["status"], -1);
+  EXPECT_TRUE(gps[1]["lla"][0].is_null());
+  EXPECT_EQ(gps[1]["cov_type"], 0);
+  // Compass: the field in tesla, the heading a turn about the world's down axis.
+  const auto mag = messages_on(bag, "/mag");
+  const auto heading = messages_on(bag, "/compass/heading");
+  ASSERT_EQ(mag.size(), 2u);
+  EXPECT_EQ(mag[0]["stamp_ns"], 50'000'000);
+  EXPECT_NEAR(mag[0]["field"][2].get<double>(), 46000e-9, 1e-18);
+  const Vec3 north_turned = quat_of(heading[1]["q"]) * Vec3::UnitX();
+  EXPECT_NEAR(std::atan2(north_turned.y(), north_turned.x()), deg2rad(350.5 - 360), 1e-12);
+  // Ground truth: the IMU's poses, exactly.
+  const auto gt = messages_on(bag, "/groundtruth/pose");
+  ASSERT_EQ(gt.size(), seq.truth.body.size());
+  for (std::size_t k = 0; k < gt.size(); ++k) {
+    const SE3& T = seq.truth.body[k].T_W_S;
+    EXPECT_EQ(gt[k]["frame_id"], "world_ned");
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(gt[k]["p"][a].get<double>(), T.translation()[a]);
+    EXPECT_LT(quat_of(gt[k]["q"]).angularDistance(T.quaternion()), 1e-15);
+  }
+  // tf_static: base_link (x forward, y left, z up) -> imu is FLU <- FRD times the mount, so the
+  // IMU's x axis (forward, turned 0.05 rad to starboard) is (cos, -sin, 0) in base_link.
+  const json tf = messages_on(bag, "/tf_static").at(0)["transforms"];
+  ASSERT_EQ(tf.size(), 5u);
+  EXPECT_EQ(tf[0]["parent"], "base_link");
+  EXPECT_EQ(tf[0]["child"], "imu");
+  const Vec3 imu_x = quat_of(tf[0]["q"]) * Vec3::UnitX();
+  EXPECT_LT((imu_x - Vec3(std::cos(0.05), -std::sin(0.05), 0)).norm(), 1e-12);
+  EXPECT_EQ(tf[0]["t"].get<std::vector<double>>(), (std::vector<double>{1, 0, 0.5}));
+  EXPECT_EQ(tf[1]["child"], "gps");
+  EXPECT_EQ(tf[1]["t"].get<std::vector<double>>(), (std::vector<double>{0, -0.5, 3}));
+  EXPECT_EQ(tf[4]["parent"], "imu");
+  EXPECT_EQ(tf[4]["child"], "cam1_optical");
+  const Vec3 cam1 = calibration().T_S_C * Vec3(0.25, 0, 0);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(tf[4]["t"][a].get<double>(), cam1[a], 1e-15);
+  // The calibration files: OpenCV's FileStorage reads VINS-Fusion's configuration.
+  cv::FileStorage vins((root / "vins_fusion" / "stereo_imu_config.yaml").string(),
+                       cv::FileStorage::READ);
+  cv::Mat body_T_cam1;
+  vins["body_T_cam1"] >> body_T_cam1;
+  ASSERT_EQ(body_T_cam1.rows, 4);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(body_T_cam1.at<double>(a, 3), cam1[a], 1e-15);
+  EXPECT_EQ(static_cast<std::string>(vins["image1_topic"]), "/cam1/image_raw");
+  EXPECT_DOUBLE_EQ(static_cast<double>(vins["gyr_n"]), 1.7e-4);
+  fs::remove_all(root);
+}
+
+TEST(RosbagExport, ReadsBackThroughItsKalibrChain) {
+  const fs::path root = test::fresh_temp_dir("rosbag_reader");
+  const Sequence seq(root / "staging");
+  seq.write(*make_writer(DatasetFormat::kRosbag, root, calibration()));
+  const StereoDataset d = read_dataset(root, DatasetFormat::kRosbag);
+  EXPECT_EQ(d.format, DatasetFormat::kRosbag);
+  EXPECT_EQ(d.rig.camera.fx, 480);
+  EXPECT_EQ(d.rig.camera.cy, 30.25);
+  EXPECT_NEAR(d.rig.baseline_m, 0.25, 1e-15);
+  EXPECT_FALSE(d.rectification);
+  EXPECT_TRUE(d.has_extrinsics);
+  EXPECT_LT((d.T_S_C.inverse() * calibration().T_S_C).log().norm(), 1e-12);
+  ASSERT_EQ(d.frames.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(d.frames[i].t_ns, seq.stamps[i]);
+    const auto [left, right] = read_pair(d, d.frames[i]);
+    EXPECT_EQ(bytes_of(left), bytes_of(seq.left[i]));
+    EXPECT_EQ(bytes_of(right), bytes_of(seq.right[i]));
+  }
+  ASSERT_EQ(d.imu.size(), seq.imu.size());
+  EXPECT_EQ(d.imu[7].gyro_rad_s, seq.imu[7].gyro_rad_s);
+  EXPECT_EQ(d.imu[7].accel_m_s2, seq.imu[7].accel_m_s2);
+  ASSERT_TRUE(d.imu_noise.has_value());
+  EXPECT_EQ(d.imu_noise->gyroscope_random_walk, 2e-5);
+  ASSERT_EQ(d.compass.size(), 2u);
+  EXPECT_NEAR(d.compass[1].heading_rad, deg2rad(350.5 - 360), 1e-12);
+  EXPECT_NEAR(d.compass[0].field_S_nt.x(), 17000, 1e-9);
+  ASSERT_EQ(d.camera_gt.size(), seq.truth.body.size());
+  const SE3 expected = seq.truth.body[5].T_W_S * calibration().T_S_C;
+  EXPECT_LT((d.camera_gt[5].T_W_C.inverse() * expected).log().norm(), 1e-12);
+  fs::remove_all(root);
+}
+
+// A Kalibr chain for the EuRoC-like bag, as OpenVINS ships them (T_imu_cam), with distortion and
+// a right camera turned a little, and the same cameras as an EuRoC folder's sensor.yaml files.
+void write_distorted_calibration(const fs::path& root) {
+  const std::string T0 = "[1, 0, 0, 0.1, 0, 1, 0, -0.02, 0, 0, 1, 0.01, 0, 0, 0, 1]";
+  const std::string T1 =
+      "[0.9998, -0.0199987, 0, 0.21, 0.0199987, 0.9998, 0, -0.02, 0, 0, 1, 0.01, 0, 0, 0, 1]";
+  const auto rows = [](const std::string& flat) {
+    std::string out, inner = flat.substr(1, flat.size() - 2);
+    std::istringstream in(inner);
+    std::vector<std::string> v;
+    for (std::string x; std::getline(in, x, ',');) v.push_back(x);
+    for (int r = 0; r < 4; ++r)
+      out += fmt::format("    - [{},{},{},{}]\n", v[4 * r], v[4 * r + 1], v[4 * r + 2],
+                         v[4 * r + 3]);
+    return out;
+  };
+  std::string chain;
+  for (int i = 0; i < 2; ++i) {
+    const std::string k = i == 0 ? "[100, 101, 47.5, 35.5]" : "[102, 103, 48.5, 36]";
+    const std::string dist = i == 0 ? "[-0.28, 0.07, 0.0002, 0.00002]" : "[-0.27, 0.06, 0, 0.0001]";
+    chain += fmt::format(
+        "cam{}:\n  T_imu_cam:\n{}  camera_model: pinhole\n  distortion_coeffs: {}\n"
+        "  distortion_model: radtan\n  intrinsics: {}\n  resolution: [96, 72]\n"
+        "  rostopic: /cam{}/image_raw\n",
+        i, rows(i == 0 ? T0 : T1), dist, k, i);
+    write_file_atomic(root / "mav0" / fmt::format("cam{}", i) / "sensor.yaml",
+                     fmt::format("sensor_type: camera\nT_BS:\n  cols: 4\n  rows: 4\n  data: {}\n"
+                                 "rate_hz: 20\nresolution: [96, 72]\ncamera_model: pinhole\n"
+                                 "intrinsics: {}\ndistortion_model: radial-tangential\n"
+                                 "distortion_coefficients: {}\n",
+                                 i == 0 ? T0 : T1, k, dist));
+  }
+  write_file_atomic(root / "openvins_euroc_chain.yaml", chain);
+}
+
+TEST(RosbagRead, AnEurocLayoutBagFromRosPythonGivesWhatItsEurocFolderGives) {
+  const fs::path root = test::fresh_temp_dir("rosbag_euroc_like");
+  python("write_euroc_bag.py", {root.string()}, root / "writer.log");
+  write_distorted_calibration(root);
+  ReadOptions options;
+  options.calibration = root / "openvins_euroc_chain.yaml";
+  const StereoDataset bag = read_dataset(root / "euroc_like.bag", DatasetFormat::kRosbag, options);
+  const StereoDataset folder = read_dataset(root, DatasetFormat::kEuroc);
+  ASSERT_TRUE(bag.rectification);
+  EXPECT_EQ(bag.rig.camera.fx, folder.rig.camera.fx);
+  EXPECT_EQ(bag.rig.baseline_m, folder.rig.baseline_m);
+  EXPECT_LT((bag.T_S_C.inverse() * folder.T_S_C).log().norm(), 1e-12);
+  ASSERT_EQ(bag.frames.size(), 4u);
+  ASSERT_EQ(folder.frames.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(bag.frames[i].t_ns, folder.frames[i].t_ns);  // header stamps, not record times
+    EXPECT_EQ(bag.frames[i].left_record_ns, bag.frames[i].t_ns + 3'000'000);
+    const auto [bl, br] = read_pair(bag, bag.frames[i]);
+    const auto [fl, fr] = read_pair(folder, folder.frames[i]);
+    EXPECT_EQ(bytes_of(bl), bytes_of(fl)) << i;
+    EXPECT_EQ(bytes_of(br), bytes_of(fr)) << i;
+  }
+  // EuRoC's Vicon topic is found without --gt-topic: the IMU's pose times T_S_C.
+  ASSERT_EQ(bag.camera_gt.size(), 40u);
+  const SE3 T_W_S(Quat(std::cos(0.005), 0, 0, std::sin(0.005)), Vec3(0.05, 1, 0.8));
+  EXPECT_LT((bag.camera_gt[5].T_W_C.inverse() * (T_W_S * bag.T_S_C)).log().norm(), 1e-12);
+  EXPECT_EQ(bag.imu.size(), 40u);
+  EXPECT_FALSE(bag.imu_noise.has_value());  // no Kalibr IMU chain beside the camera chain
+  // Position-only truth is a clear error naming the topic and why.
+  options.gt_topic = "/leica/position";
+  const std::string leica = test::user_error_of(
+      [&] { read_dataset(root / "euroc_like.bag", DatasetFormat::kRosbag, options); });
+  EXPECT_NE(leica.find("/leica/position: got ground truth of type geometry_msgs/PointStamped"),
+            std::string::npos)
+      << leica;
+  fs::remove_all(root);
+}
+
+TEST(RosbagRead, BadInputIsAClearError) {
+  const fs::path root = test::fresh_temp_dir("rosbag_errors");
+  const Sequence seq(root / "export" / "staging");
+  seq.write(*make_writer(DatasetFormat::kRosbag, root / "export", calibration()));
+  const fs::path bag = root / "export" / rosbag_names::kBagFile;
+  const auto read = [&](const fs::path& path, const ReadOptions& o) {
+    return test::user_error_of([&] { read_dataset(path, DatasetFormat::kRosbag, o); });
+  };
+  // No calibration beside the bag.
+  fs::create_directories(root / "alone");
+  fs::copy_file(bag, root / "alone" / "x.bag");
+  EXPECT_NE(read(root / "alone" / "x.bag", {}).find("no camera calibration: expected "
+                                                     "kalibr_imucam_chain.yaml beside the bag"),
+            std::string::npos);
+  // Not a bag.
+  write_file_atomic(root / "export" / "text.bag", "#ROSBAG V2.0\nnot really\n");
+  ReadOptions o;
+  o.calibration = root / "export" / rosbag_names::kCamchainFile;
+  EXPECT_NE(read(root / "export" / "text.bag", o).find("text.bag: not a readable ROS 1 bag"),
+            std::string::npos)
+      << read(root / "export" / "text.bag", o);
+  // Two bags in a folder, neither driftlab.bag: which one?
+  fs::copy_file(bag, root / "alone" / "y.bag");
+  EXPECT_NE(read(root / "alone", {}).find("found 2 .bag files"), std::string::npos);
+  // A ground-truth topic that is not there.
+  o.gt_topic = "/nothing";
+  EXPECT_NE(read(bag, o).find("--gt-topic: no messages on '/nothing'"), std::string::npos);
+  // A camera topic with messages of another type.
+  o.gt_topic.clear();
+  std::string chain = slurp(o.calibration);
+  chain.replace(chain.find("rostopic: /cam1/image_raw"), 25, "rostopic: /imu0");
+  write_file_atomic(root / "chain.yaml", chain);
+  o.calibration = root / "chain.yaml";
+  EXPECT_NE(read(bag, o).find("/imu0: got messages of type sensor_msgs/Imu, expected "
+                              "sensor_msgs/Image"),
+            std::string::npos)
+      << read(bag, o);
+  fs::remove_all(root);
+}
+
+}  // namespace
+}  // namespace driftlab::dataset
