@@ -113,7 +113,8 @@ TEST(ExternalVo, RealFailingHangingAndGarbageCommandsAreEachRecorded) {
       script("garbage.sh") +
       " {out}'}, {name: mine_euroc, format: euroc, output: tum, command: 'test -f "
       "{dir}/mav0/imu0/data.csv && test -f {dir}/mav0/state_groundtruth_estimate0/data.csv && "
-      "cp {root}/../../mine/trajectory.tum {out}'}]";
+      "cp {root}/../../mine/trajectory.tum {out}'}, {name: mine_bag, format: rosbag, command: '" +
+      script("driftlab_sparse.sh") + " {driftlab} {dir} {root} {out} rosbag'}]";
   const auto t0 = std::chrono::steady_clock::now();
   const auto r = test::run_cli(
       {"run", (test::source_dir() / "scenarios/river_crossing.yaml").string(), "--set",
@@ -155,6 +156,11 @@ TEST(ExternalVo, RealFailingHangingAndGarbageCommandsAreEachRecorded) {
   EXPECT_TRUE(m["algorithms"].contains("sparse"));
   EXPECT_FALSE(m["algorithms"].contains("broken"));
   EXPECT_LT(largest_difference(read_tum(out / "estimates/mine.tum"),
+                               read_tum(out / "estimates/sparse.tum")),
+            1e-9);
+  // The same VO reading the run's frames from a ROS 1 bag.
+  EXPECT_EQ(ext["mine_bag"]["status"], "ok") << ext["mine_bag"];
+  EXPECT_LT(largest_difference(read_tum(out / "estimates/mine_bag.tum"),
                                read_tum(out / "estimates/sparse.tum")),
             1e-9);
   EXPECT_NE(slurp(out / "report.md").find("| stuck | timeout | exit code 124 |"),
