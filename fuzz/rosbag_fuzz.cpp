@@ -23,8 +23,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fuzz::expect_user_errors_only([&] {
     dataset::ReadOptions options;
     options.calibration = chain;
-    const dataset::StereoDataset d = dataset::read_dataset(bag, dataset::DatasetFormat::kRosbag,
-                                                           options);
+    const dataset::StereoDataset d =
+        dataset::read_dataset(bag, dataset::DatasetFormat::kRosbag, options);
     for (std::size_t i = 0; i < d.frames.size() && i < 8; ++i)
       (void)dataset::read_pair(d, d.frames[i]);
   });
