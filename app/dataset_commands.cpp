@@ -30,9 +30,10 @@ std::string one_of(const std::string& name, const std::vector<std::string>& name
 DatasetCommands::DatasetCommands(CLI::App& app) {
   export_ = app.add_subcommand(
       "export",
-      "Render a scenario into a dataset other tools read (KITTI, EuRoC, TUM RGB-D, ROS 1 bag)");
+      "Render a scenario into a dataset other tools read (KITTI, EuRoC, TUM RGB-D, ROS bags)");
   export_->add_option("SCENARIO", scenario_, "Scenario YAML file")->required();
-  export_->add_option("--format", format_, "Dataset layout: kitti, euroc, tum-rgbd or rosbag")
+  export_
+      ->add_option("--format", format_, "Dataset layout: kitti, euroc, tum-rgbd, rosbag or rosbag2")
       ->capture_default_str();
   export_->add_option("--out", out_, "Output folder (written atomically)")->required();
   export_->add_option("--sequence", sequence_, "KITTI sequence number")->capture_default_str();

@@ -26,8 +26,10 @@ DatasetFormat format_from_name(std::string_view name) {
   if (lower == "euroc") return DatasetFormat::kEuroc;
   if (lower == "tum-rgbd") return DatasetFormat::kTumRgbd;
   if (lower == "rosbag") return DatasetFormat::kRosbag;
+  if (lower == "rosbag2") return DatasetFormat::kRosbag2;
   throw UserError(fmt::format(
-      "unknown dataset format: got '{}', expected one of: kitti, euroc, tum-rgbd, rosbag", name));
+      "unknown dataset format: got '{}', expected one of: kitti, euroc, tum-rgbd, rosbag, rosbag2",
+      name));
 }
 
 std::string_view format_name(DatasetFormat format) {
@@ -40,6 +42,8 @@ std::string_view format_name(DatasetFormat format) {
       return "tum-rgbd";
     case DatasetFormat::kRosbag:
       return "rosbag";
+    case DatasetFormat::kRosbag2:
+      return "rosbag2";
   }
   return "?";
 }
@@ -55,6 +59,8 @@ std::unique_ptr<DatasetWriter> make_writer(DatasetFormat format, const fs::path&
       return detail::make_tum_rgbd_writer(root, calibration);
     case DatasetFormat::kRosbag:
       return detail::make_rosbag_writer(root, calibration);
+    case DatasetFormat::kRosbag2:
+      return detail::make_rosbag2_writer(root, calibration);
   }
   return nullptr;
 }
@@ -75,6 +81,11 @@ StereoDataset read_dataset(const fs::path& root, DatasetFormat format, const Rea
                       root.string()));
     case DatasetFormat::kRosbag:
       break;
+    case DatasetFormat::kRosbag2:
+      throw UserError(fmt::format(
+          "{}: driftlab vo reads ROS 1 bags (--format rosbag), not ROS 2 ones; `ros2 bag convert` "
+          "or the rosbags Python package turns one into the other",
+          root.string()));
   }
   return {};
 }

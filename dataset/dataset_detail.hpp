@@ -94,6 +94,8 @@ std::unique_ptr<DatasetWriter> make_tum_rgbd_writer(const std::filesystem::path&
                                                     const ExportCalibration& calibration);
 std::unique_ptr<DatasetWriter> make_rosbag_writer(const std::filesystem::path& root,
                                                   const ExportCalibration& calibration);
+std::unique_ptr<DatasetWriter> make_rosbag2_writer(const std::filesystem::path& root,
+                                                   const ExportCalibration& calibration);
 StereoDataset read_rosbag(const std::filesystem::path& path, const ReadOptions& options);
 StereoDataset read_kitti(const std::filesystem::path& root, const ReadOptions& options);
 StereoDataset read_euroc(const std::filesystem::path& root);

@@ -1,6 +1,8 @@
-// ROS 1 bags (format 2.0, wiki.ros.org/Bags/Format/2.0) as driftlab writes and reads them,
-// through Debian's rosbag_storage. Shared by the writer and the reader (not included outside
-// dataset/).
+// ROS bags as driftlab writes them: ROS 1 (format 2.0, wiki.ros.org/Bags/Format/2.0, written
+// and read through Debian's rosbag_storage) and ROS 2 (rosbag2's sqlite3 storage, CDR; written
+// only). Shared by the writers and the reader (not included outside dataset/). A ROS 2 bag
+// carries the same topics with ROS 2's types (sensor_msgs/msg/Image, ...), every stamp as it
+// is (no record time), and /tf_static offered transient local.
 //
 // Topics (EuRoC's names where EuRoC has the stream):
 //   /cam0/image_raw, /cam1/image_raw  sensor_msgs/Image, mono8, rectified; frame camN_optical
@@ -28,6 +30,8 @@
 namespace driftlab::dataset::rosbag_names {
 
 inline constexpr const char* kBagFile = "driftlab.bag";
+/// A ROS 2 export's bag: this folder, with metadata.yaml and rosbag2_0.db3.
+inline constexpr const char* kBag2Folder = "rosbag2";
 inline constexpr const char* kCamchainFile = "kalibr_imucam_chain.yaml";
 inline constexpr const char* kImuChainFile = "kalibr_imu_chain.yaml";
 

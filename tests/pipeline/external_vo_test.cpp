@@ -114,7 +114,10 @@ TEST(ExternalVo, RealFailingHangingAndGarbageCommandsAreEachRecorded) {
       " {out}'}, {name: mine_euroc, format: euroc, output: tum, command: 'test -f "
       "{dir}/mav0/imu0/data.csv && test -f {dir}/mav0/state_groundtruth_estimate0/data.csv && "
       "cp {root}/../../mine/trajectory.tum {out}'}, {name: mine_bag, format: rosbag, command: '" +
-      script("driftlab_sparse.sh") + " {driftlab} {dir} {root} {out} rosbag'}]";
+      script("driftlab_sparse.sh") +
+      " {driftlab} {dir} {root} {out} rosbag'}, {name: mine_ros2, format: rosbag2, output: tum, "
+      "command: 'test -f {dir}/rosbag2/metadata.yaml && test -f {dir}/rosbag2/rosbag2_0.db3 && "
+      "cp {root}/../../mine/trajectory.tum {out}'}]";
   const auto t0 = std::chrono::steady_clock::now();
   const auto r = test::run_cli(
       {"run", (test::source_dir() / "scenarios/river_crossing.yaml").string(), "--set",
@@ -160,6 +163,7 @@ TEST(ExternalVo, RealFailingHangingAndGarbageCommandsAreEachRecorded) {
             1e-9);
   // The same VO reading the run's frames from a ROS 1 bag.
   EXPECT_EQ(ext["mine_bag"]["status"], "ok") << ext["mine_bag"];
+  EXPECT_EQ(ext["mine_ros2"]["status"], "ok") << ext["mine_ros2"];  // a ROS 2 bag to read
   EXPECT_LT(largest_difference(read_tum(out / "estimates/mine_bag.tum"),
                                read_tum(out / "estimates/sparse.tum")),
             1e-9);
