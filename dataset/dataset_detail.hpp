@@ -96,6 +96,9 @@ std::unique_ptr<DatasetWriter> make_rosbag_writer(const std::filesystem::path& r
                                                   const ExportCalibration& calibration);
 std::unique_ptr<DatasetWriter> make_rosbag2_writer(const std::filesystem::path& root,
                                                    const ExportCalibration& calibration);
+/// UserError naming the byte of the first record of the ROS 1 bag at `path` whose lengths,
+/// chunk sizes or counts do not fit the file (rosbag_check.cpp). Reads the headers only.
+void check_bag_structure(const std::filesystem::path& path);
 StereoDataset read_rosbag(const std::filesystem::path& path, const ReadOptions& options);
 StereoDataset read_kitti(const std::filesystem::path& root, const ReadOptions& options);
 StereoDataset read_euroc(const std::filesystem::path& root);

@@ -183,11 +183,13 @@ CameraCalibration camera_from_keys(const YAML::Node& root, const fs::path& path,
         root["distortion_model"].IsScalar() ? root["distortion_model"].Scalar() : "(not a name)";
   const bool radtan = c.distortion_model.empty() || c.distortion_model == "radial-tangential" ||
                       c.distortion_model == "radtan" || c.distortion_model == "plumb_bob";
-  if (!radtan || (c.distortion.size() != 0 && c.distortion.size() != 4 && c.distortion.size() != 5))
+  const std::size_t n = c.distortion.size();
+  if (c.distortion_model == "equidistant" && n == 4) return c;  // Kannala-Brandt k1..k4
+  if (!radtan || (n != 0 && n != 4 && n != 5))
     throw UserError(fmt::format(
         "{}: {}distortion_model: got '{}' with {} coefficients, expected radial-tangential with 4 "
-        "(k1, k2, p1, p2) or 5",
-        path.string(), prefix, c.distortion_model, c.distortion.size()));
+        "(k1, k2, p1, p2) or 5, or equidistant with 4 (k1..k4)",
+        path.string(), prefix, c.distortion_model, n));
   return c;
 }
 
@@ -263,6 +265,8 @@ std::vector<std::pair<TimeNs, std::string>> read_camera_index(const fs::path& pa
   return out;
 }
 
+bool is_fisheye(const CameraYaml& c) { return c.distortion_model == "equidistant"; }
+
 // Whether the pair is already what the VOs take: equal pinholes, no distortion, the right
 // camera moved along the left one's x axis only.
 bool already_rectified(const CameraYaml& c0, const CameraYaml& c1) {
@@ -271,8 +275,10 @@ bool already_rectified(const CameraYaml& c0, const CameraYaml& c1) {
   bool rectified = baseline > 0 && std::abs(T_C0_C1.translation().y()) < 1e-6 * baseline &&
                    std::abs(T_C0_C1.translation().z()) < 1e-6 * baseline &&
                    (T_C0_C1.rotation() - Mat3::Identity()).cwiseAbs().maxCoeff() < 1e-9;
-  for (const auto* c : {&c0, &c1})
+  for (const auto* c : {&c0, &c1}) {
+    rectified = rectified && !is_fisheye(*c);  // r = f theta, not f tan theta, even at k = 0
     for (double d : c->distortion) rectified = rectified && d == 0;
+  }
   const PinholeCamera &a = c0.camera, &b = c1.camera;
   return rectified && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy &&
          a.width == b.width && a.height == b.height;
@@ -308,10 +314,21 @@ RectifiedPair rectify_pair(const CameraYaml& c0, const CameraYaml& c1, const fs:
     for (int j = 0; j < 3; ++j) R(i, j) = Re(i, j);
   const Vec3 te = T_C1_C0.translation();
   const cv::Vec3d T(te.x(), te.y(), te.z());
+  if (is_fisheye(c0) != is_fisheye(c1))
+    throw UserError(
+        fmt::format("{}: distortion_model: got '{}' and cam0's '{}', expected one "
+                    "model for both cameras",
+                    cam1_yaml.string(), c1.distortion_model, c0.distortion_model));
+  const bool fisheye = is_fisheye(c0);
   cv::Mat R1, R2, P1, P2, Q;
-  cv::stereoRectify(camera_matrix(c0.camera), c0.distortion, camera_matrix(c1.camera),
-                    c1.distortion, size, R, T, R1, R2, P1, P2, Q, cv::CALIB_ZERO_DISPARITY, 0,
-                    size);
+  if (fisheye)  // equidistant lenses: OpenCV's fisheye model (Kannala-Brandt), balance 0
+    cv::fisheye::stereoRectify(camera_matrix(c0.camera), c0.distortion, camera_matrix(c1.camera),
+                               c1.distortion, size, R, T, R1, R2, P1, P2, Q,
+                               cv::CALIB_ZERO_DISPARITY, size, 0.0, 1.0);
+  else
+    cv::stereoRectify(camera_matrix(c0.camera), c0.distortion, camera_matrix(c1.camera),
+                      c1.distortion, size, R, T, R1, R2, P1, P2, Q, cv::CALIB_ZERO_DISPARITY, 0,
+                      size);
   const double baseline = -P2.at<double>(0, 3) / P2.at<double>(0, 0);
   if (!(baseline > 0))
     throw UserError(
@@ -319,10 +336,17 @@ RectifiedPair rectify_pair(const CameraYaml& c0, const CameraYaml& c1, const fs:
                     "baseline {} m), expected the right camera as cam1",
                     cam1_yaml.string(), baseline));
   auto maps = std::make_shared<Rectification>();
-  cv::initUndistortRectifyMap(camera_matrix(c0.camera), c0.distortion, R1, P1, size, CV_16SC2,
-                              maps->left_map1, maps->left_map2);
-  cv::initUndistortRectifyMap(camera_matrix(c1.camera), c1.distortion, R2, P2, size, CV_16SC2,
-                              maps->right_map1, maps->right_map2);
+  const auto map = [&](const CameraYaml& c, const cv::Mat& Ri, const cv::Mat& Pi, cv::Mat* m1,
+                       cv::Mat* m2) {
+    if (fisheye)
+      cv::fisheye::initUndistortRectifyMap(camera_matrix(c.camera), c.distortion, Ri, Pi, size,
+                                           CV_16SC2, *m1, *m2);
+    else
+      cv::initUndistortRectifyMap(camera_matrix(c.camera), c.distortion, Ri, Pi, size, CV_16SC2,
+                                  *m1, *m2);
+  };
+  map(c0, R1, P1, &maps->left_map1, &maps->left_map2);
+  map(c1, R2, P2, &maps->right_map1, &maps->right_map2);
   out.rectification = maps;
   out.rig.camera = {P1.at<double>(0, 0), P1.at<double>(1, 1), P1.at<double>(0, 2),
                     P1.at<double>(1, 2), size.width,          size.height};

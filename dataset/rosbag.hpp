@@ -45,6 +45,8 @@ inline constexpr const char* kGroundTruth = "/groundtruth/pose";
 inline constexpr const char* kTfStatic = "/tf_static";
 /// EuRoC's Vicon-room ground truth (geometry_msgs/TransformStamped).
 inline constexpr const char* kEurocVicon = "/vicon/firefly_sbx/firefly_sbx";
+/// TUM-VI's motion-capture ground truth (geometry_msgs/TransformStamped).
+inline constexpr const char* kTumViMocap = "/vrpn_client/raw_transform";
 
 inline constexpr const char* kOpticalFrame[2] = {"cam0_optical", "cam1_optical"};
 inline constexpr const char* kImuFrame = "imu";

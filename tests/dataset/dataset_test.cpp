@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <fstream>
+#include <functional>
 #include <numbers>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -237,20 +238,30 @@ TEST(DatasetReaders, NameTheFileLineAndExpectation) {
   EXPECT_NE(e.find("expected sequences/07/"), std::string::npos) << e;
   e = error_of([&] { read_dataset(root / "nowhere", DatasetFormat::kEuroc); });
   EXPECT_NE(e.find("no such dataset folder"), std::string::npos) << e;
-  e = error_of([] { format_from_name("rosbag"); });
-  EXPECT_NE(e.find("got 'rosbag', expected one of: kitti, euroc, tum-rgbd"), std::string::npos);
+  e = error_of([] { format_from_name("mcap"); });
+  EXPECT_NE(e.find("got 'mcap', expected one of: kitti, euroc, tum-rgbd, rosbag, rosbag2"),
+            std::string::npos);
 
-  // EuRoC: a lens model other than radial-tangential is refused; a bad stamp names its line.
+  // EuRoC: a lens model other than radial-tangential or equidistant is refused, and so is a
+  // pair with one of each; a bad stamp names its line.
   const fs::path eu = test::fresh_temp_dir("dataset_errors_euroc");
   Sequence{}.write(*make_writer(DatasetFormat::kEuroc, eu, calibration()));
   const fs::path cam1 = eu / "mav0" / "cam1" / "sensor.yaml";
   const std::string good_yaml = slurp(cam1);
   std::string yaml = good_yaml;
+  yaml.replace(yaml.find("radial-tangential"), 17, "omni");
+  std::ofstream(cam1) << yaml;
+  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  EXPECT_NE(e.find("distortion_model: got 'omni' with 4 coefficients, expected "
+                   "radial-tangential"),
+            std::string::npos)
+      << e;
+  yaml = good_yaml;
   yaml.replace(yaml.find("radial-tangential"), 17, "equidistant");
   std::ofstream(cam1) << yaml;
   e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
-  EXPECT_NE(e.find("distortion_model: got 'equidistant' with 4 coefficients, expected "
-                   "radial-tangential"),
+  EXPECT_NE(e.find("distortion_model: got 'equidistant' and cam0's 'radial-tangential', expected "
+                   "one model for both cameras"),
             std::string::npos)
       << e;
   // What the fuzzer found (fuzz/regressions/dataset): each a UserError naming the file.
@@ -341,17 +352,19 @@ namespace {
 // A raw EuRoC pair (lens distortion, the right camera turned by 1 deg): rectified as it is
 // read. Each point's rectified pixels, followed through the maps back into the raw images,
 // land where OpenCV's own distorted projection puts it, and the rectified rows agree.
-TEST(EurocRaw, IsRectifiedWhenReadWithTheRigAndPosesOfTheRectifiedPair) {
+using LensProjection =
+    std::function<cv::Point2d(const Vec3&, const cv::Matx33d&, const std::vector<double>&)>;
+void expect_the_maps_follow_the_lenses(const PinholeCamera& camera, const std::string& model,
+                                       const std::vector<double>& D0, const std::vector<double>& D1,
+                                       const LensProjection& project) {
   const fs::path root = test::fresh_temp_dir("euroc_raw");
   ExportCalibration cal = calibration();
-  cal.rig.camera = {458.7, 457.3, 367.2, 248.4, 752, 480};  // EuRoC-like
+  cal.rig.camera = camera;
   cal.rig.baseline_m = 0.11;
   Sequence seq;
-  seq.left.assign(3, cv::Mat(480, 752, CV_8UC1, cv::Scalar(0)));
+  seq.left.assign(3, cv::Mat(camera.height, camera.width, CV_8UC1, cv::Scalar(0)));
   seq.right = seq.left;
   seq.write(*make_writer(DatasetFormat::kEuroc, root, cal));
-  const std::vector<double> D0 = {-0.28, 0.074, 0.0002, 0.00002},
-                            D1 = {-0.283, 0.074, -0.0001, 0.0};
   const SE3 T_B_C0 = cal.T_S_C;
   const SE3 T_C0_C1(quat_from_euler_zyx({0.0, 0.0, deg2rad(1.0)}), Vec3(0.11, 0.001, -0.002));
   const SE3 T_B_C1 = T_B_C0 * T_C0_C1;
@@ -363,6 +376,7 @@ TEST(EurocRaw, IsRectifiedWhenReadWithTheRigAndPosesOfTheRectifiedPair) {
               "  data: [" + detail::matrix_text(detail::matrix_4x4(T), ", ") + "]");
     const auto dist = y.find("[0.0, 0.0, 0.0, 0.0]");
     y.replace(dist, 20, fmt::format("[{}, {}, {}, {}]", D[0], D[1], D[2], D[3]));
+    y.replace(y.find("radial-tangential"), 17, model);
     std::ofstream(p) << y;
   };
   write_yaml(0, T_B_C0, D0);
@@ -373,7 +387,8 @@ TEST(EurocRaw, IsRectifiedWhenReadWithTheRigAndPosesOfTheRectifiedPair) {
   cv::Mat lx, ly, rx, ry;
   cv::convertMaps(d.rectification->left_map1, d.rectification->left_map2, lx, ly, CV_32FC1);
   cv::convertMaps(d.rectification->right_map1, d.rectification->right_map2, rx, ry, CV_32FC1);
-  const cv::Matx33d K(458.7, 0, 367.2, 0, 457.3, 248.4, 0, 0, 1);
+  const cv::Matx33d K(camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+  const double W = camera.width, H = camera.height;
   const SE3 T_Crect_C0 = d.T_S_C.inverse() * T_B_C0;
   std::size_t checked = 0;
   for (double x : {-2.0, -0.5, 0.0, 1.0, 2.5})
@@ -383,30 +398,54 @@ TEST(EurocRaw, IsRectifiedWhenReadWithTheRigAndPosesOfTheRectifiedPair) {
         const Vec3 X_rect = T_Crect_C0 * X_c0;
         const Eigen::Vector2d l = d.rig.camera.project(X_rect);
         const Eigen::Vector2d r = d.rig.project_right(X_rect);
-        if (l.x() < 5 || l.x() > 745 || l.y() < 5 || l.y() > 473 || r.x() < 5 || r.x() > 745)
+        if (l.x() < 5 || l.x() > W - 7 || l.y() < 5 || l.y() > H - 7 || r.x() < 5 || r.x() > W - 7)
           continue;
-        // The maps take a rectified pixel to the raw one; nearest map sample.
+        // The maps take a rectified pixel to the raw one, interpolated bilinearly.
         const auto raw_of = [](const cv::Mat& mx, const cv::Mat& my, const Eigen::Vector2d& p) {
-          const int u = static_cast<int>(std::lround(p.x())),
-                    v = static_cast<int>(std::lround(p.y()));
-          return cv::Point2d(mx.at<float>(v, u) + (p.x() - u), my.at<float>(v, u) + (p.y() - v));
+          cv::Mat sx, sy;
+          const cv::Mat at(1, 1, CV_32FC2, cv::Scalar(p.x(), p.y()));
+          cv::remap(mx, sx, at, cv::noArray(), cv::INTER_LINEAR);
+          cv::remap(my, sy, at, cv::noArray(), cv::INTER_LINEAR);
+          return cv::Point2d(sx.at<float>(0, 0), sy.at<float>(0, 0));
         };
-        std::vector<cv::Point2d> expected_l, expected_r;
-        cv::projectPoints(std::vector<cv::Point3d>{{x, y, z}}, cv::Vec3d(0, 0, 0),
-                          cv::Vec3d(0, 0, 0), K, D0, expected_l);
-        const Vec3 X_c1 = T_C0_C1.inverse() * X_c0;
-        cv::projectPoints(std::vector<cv::Point3d>{{X_c1.x(), X_c1.y(), X_c1.z()}},
-                          cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D1, expected_r);
-        EXPECT_LT(cv::norm(raw_of(lx, ly, l) - expected_l[0]), 0.3) << x << " " << y << " " << z;
-        EXPECT_LT(cv::norm(raw_of(rx, ry, r) - expected_r[0]), 0.3) << x << " " << y << " " << z;
+        const cv::Point2d expected_l = project(X_c0, K, D0);
+        const cv::Point2d expected_r = project(T_C0_C1.inverse() * X_c0, K, D1);
+        EXPECT_LT(cv::norm(raw_of(lx, ly, l) - expected_l), 0.3) << model << " " << x << " " << y;
+        EXPECT_LT(cv::norm(raw_of(rx, ry, r) - expected_r), 0.3) << model << " " << x << " " << y;
         EXPECT_NEAR(l.y(), r.y(), 1e-9);  // rectified: the same row
         ++checked;
       }
-  EXPECT_GE(checked, 15u);
+  EXPECT_GE(checked, 12u) << model;
   const auto [left, right] = read_pair(d, d.frames[0]);
-  EXPECT_EQ(left.size(), cv::Size(752, 480));
+  EXPECT_EQ(left.size(), cv::Size(camera.width, camera.height));
   EXPECT_EQ(right.type(), CV_8UC1);
   fs::remove_all(root);
+}
+
+TEST(EurocRaw, IsRectifiedWhenReadWithTheRigAndPosesOfTheRectifiedPair) {
+  expect_the_maps_follow_the_lenses(
+      {458.7, 457.3, 367.2, 248.4, 752, 480}, "radial-tangential",  // EuRoC-like
+      {-0.28, 0.074, 0.0002, 0.00002}, {-0.283, 0.074, -0.0001, 0.0},
+      [](const Vec3& X, const cv::Matx33d& K, const std::vector<double>& D) {
+        std::vector<cv::Point2d> p;
+        cv::projectPoints(std::vector<cv::Point3d>{{X.x(), X.y(), X.z()}}, cv::Vec3d(0, 0, 0),
+                          cv::Vec3d(0, 0, 0), K, D, p);
+        return p[0];
+      });
+}
+
+// TUM-VI's cameras: equidistant (Kannala-Brandt) lenses of about 195 deg, rectified with
+// OpenCV's fisheye model; the same check against cv::fisheye::projectPoints.
+TEST(EurocRaw, EquidistantLensesAreRectifiedWithTheFisheyeModel) {
+  expect_the_maps_follow_the_lenses(
+      {190.98, 190.99, 254.93, 256.90, 512, 512}, "equidistant",  // TUM-VI-like
+      {0.00348, 0.000715, -0.00205, 0.000203}, {0.00341, 0.00171, -0.00283, 0.000382},
+      [](const Vec3& X, const cv::Matx33d& K, const std::vector<double>& D) {
+        std::vector<cv::Point2d> p;
+        cv::fisheye::projectPoints(std::vector<cv::Point3d>{{X.x(), X.y(), X.z()}}, p,
+                                   cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D);
+        return p[0];
+      });
 }
 
 }  // namespace

@@ -372,10 +372,10 @@ TEST(ExportCli, WritesEachFormatAndVoReadsIt) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(fs::exists(root / "tum" / "depth.txt"));
   EXPECT_TRUE(fs::exists(root / "tum" / "info.yaml"));
-  r = test::run_cli({"export", scenario, "--format", "rosbag", "--out", (root / "x").string()});
+  r = test::run_cli({"export", scenario, "--format", "mcap", "--out", (root / "x").string()});
   EXPECT_EQ(r.exit_code, 2);  // a bad command line
-  EXPECT_NE(r.err.find("--format: unknown dataset format: got 'rosbag', expected one of: kitti, "
-                       "euroc, tum-rgbd"),
+  EXPECT_NE(r.err.find("--format: unknown dataset format: got 'mcap', expected one of: kitti, "
+                       "euroc, tum-rgbd, rosbag, rosbag2"),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(root / "x"));  // nothing half-written
