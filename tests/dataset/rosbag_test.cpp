@@ -304,7 +304,8 @@ void write_distorted_calibration(const fs::path& root) {
           fmt::format("    - [{},{},{},{}]\n", v[4 * r], v[4 * r + 1], v[4 * r + 2], v[4 * r + 3]);
     return out;
   };
-  std::string chain;
+  // OpenVINS's files start with OpenCV's directive, which is not YAML 1.2's.
+  std::string chain = "%YAML:1.0 # need to specify the file type at the top!\n\n";
   for (int i = 0; i < 2; ++i) {
     const std::string k = i == 0 ? "[100, 101, 47.5, 35.5]" : "[102, 103, 48.5, 36]";
     const std::string dist = i == 0 ? "[-0.28, 0.07, 0.0002, 0.00002]" : "[-0.27, 0.06, 0, 0.0001]";
