@@ -186,6 +186,15 @@ Evaluation evaluate(const EvaluationInput& in) {
   PlanarStates est_states = planar_states(t, est_aligned, true);
   est_states.heading_rad = planar_states(t, est, true).heading_rad;
   e.basin = basin_table(planar_states(t, gt, true), est_states);
+  if (in.basin_reference) {
+    e.basin_reference_name = in.basin_reference_name;
+    e.basin_reference =
+        basin_table(*in.basin_reference, t, est_states, seconds_to_ns(opt.association_tolerance_s),
+                    &e.basin_reference_pairs);
+    if (e.basin_reference_pairs == 0)
+      e.warnings.push_back(fmt::format("no estimate pose within {} s of the {}'s times",
+                                       opt.association_tolerance_s, e.basin_reference_name));
+  }
   return e;
 }
 
@@ -349,11 +358,19 @@ nlohmann::json to_json(const Evaluation& e, const EvalOptions& options) {
                           {"sd", b.number(s.sd_sample, key + ".sd")},
                           {"n", s.n}};
   };
-  j["basin"] = {{"north_m", basin_row(e.basin.north_m, "basin.north_m")},
-                {"east_m", basin_row(e.basin.east_m, "basin.east_m")},
-                {"surge_m_s", basin_row(e.basin.surge_m_s, "basin.surge_m_s")},
-                {"sway_m_s", basin_row(e.basin.sway_m_s, "basin.sway_m_s")},
-                {"heading_deg", basin_row(e.basin.heading_deg, "basin.heading_deg")}};
+  auto basin_json = [&](const BasinTable& t, const std::string& key) {
+    return nlohmann::json{{"north_m", basin_row(t.north_m, key + ".north_m")},
+                          {"east_m", basin_row(t.east_m, key + ".east_m")},
+                          {"surge_m_s", basin_row(t.surge_m_s, key + ".surge_m_s")},
+                          {"sway_m_s", basin_row(t.sway_m_s, key + ".sway_m_s")},
+                          {"heading_deg", basin_row(t.heading_deg, key + ".heading_deg")}};
+  };
+  j["basin"] = basin_json(e.basin, "basin");
+  if (e.basin_reference) {
+    j["basin_overhead"] = basin_json(*e.basin_reference, "basin_overhead");
+    j["basin_overhead"]["reference"] = e.basin_reference_name;
+    j["basin_overhead"]["pairs"] = e.basin_reference_pairs;
+  }
   j["kitti"] = nlohmann::json::array();
   for (const auto& k : e.kitti) {
     const std::string key = fmt::format("kitti[{}]", k.length_m);
@@ -489,17 +506,23 @@ std::string tables_markdown(const Evaluation& e, const EvalOptions& options) {
   md +=
       "\n## Basin paper table: RMSE and standard deviation of the errors (Kučić and Valčić "
       "2020, Tables 2-3)\n\n";
-  md += "| quantity | RMSE | std |\n|---|---|---|\n";
-  md += fmt::format("| N (cm) | {} | {} |\n", fixed(e.basin.north_m.rmse * 100, 3),
-                    fixed(e.basin.north_m.sd_sample * 100, 3));
-  md += fmt::format("| E (cm) | {} | {} |\n", fixed(e.basin.east_m.rmse * 100, 3),
-                    fixed(e.basin.east_m.sd_sample * 100, 3));
-  md += fmt::format("| u (cm/s) | {} | {} |\n", fixed(e.basin.surge_m_s.rmse * 100, 3),
-                    fixed(e.basin.surge_m_s.sd_sample * 100, 3));
-  md += fmt::format("| v (cm/s) | {} | {} |\n", fixed(e.basin.sway_m_s.rmse * 100, 3),
-                    fixed(e.basin.sway_m_s.sd_sample * 100, 3));
-  md += fmt::format("| ψ (deg) | {} | {} |\n", fixed(e.basin.heading_deg.rmse, 3),
-                    fixed(e.basin.heading_deg.sd_sample, 3));
+  const auto rows = [&](const BasinTable& b, const std::string& label) {
+    std::string r;
+    r += fmt::format("| N (cm) | {} | {} | {} |\n", label, fixed(b.north_m.rmse * 100, 3),
+                     fixed(b.north_m.sd_sample * 100, 3));
+    r += fmt::format("| E (cm) | {} | {} | {} |\n", label, fixed(b.east_m.rmse * 100, 3),
+                     fixed(b.east_m.sd_sample * 100, 3));
+    r += fmt::format("| u (cm/s) | {} | {} | {} |\n", label, fixed(b.surge_m_s.rmse * 100, 3),
+                     fixed(b.surge_m_s.sd_sample * 100, 3));
+    r += fmt::format("| v (cm/s) | {} | {} | {} |\n", label, fixed(b.sway_m_s.rmse * 100, 3),
+                     fixed(b.sway_m_s.sd_sample * 100, 3));
+    r += fmt::format("| ψ (deg) | {} | {} | {} |\n", label, fixed(b.heading_deg.rmse, 3),
+                     fixed(b.heading_deg.sd_sample, 3));
+    return r;
+  };
+  md += "| quantity | against | RMSE | std |\n|---|---|---|---|\n";
+  md += rows(e.basin, "exact truth");
+  if (e.basin_reference) md += rows(*e.basin_reference, e.basin_reference_name);
 
   md +=
       "\n## Standard metrics\n\n| metric | RMSE | mean | median | std | max |\n"

@@ -31,6 +31,10 @@ struct EvaluationInput {
   std::string algorithm = "estimate";  // name in tables and sections.csv
   std::optional<FrameTable> frames;    // per-frame covariates (frames.csv)
   EvalOptions options;
+  /// A second reference for the basin paper's table (the basin's overhead camera), with the
+  /// name its table goes by.
+  std::optional<PlanarReference> basin_reference;
+  std::string basin_reference_name = "overhead camera";
 };
 
 struct SubtrackEvaluation {
@@ -57,6 +61,10 @@ struct Evaluation {
   std::optional<OlsResult> regression;                      // Table 3
   std::string regression_skipped;                           // why, when not run
   BasinTable basin;
+  /// The basin paper's table against `EvaluationInput::basin_reference`, when given.
+  std::optional<BasinTable> basin_reference;
+  std::string basin_reference_name;
+  std::size_t basin_reference_pairs = 0;
   std::vector<KittiSegmentResult> kitti;
   std::vector<std::string> warnings;
 

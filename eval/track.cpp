@@ -1,5 +1,7 @@
 #include "eval/track.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/error.hpp"
@@ -109,6 +111,33 @@ BasinTable basin_table(const PlanarStates& ref, const PlanarStates& est) {
   return {errors(ref.north_m, est.north_m, false), errors(ref.east_m, est.east_m, false),
           errors(ref.surge_m_s, est.surge_m_s, false), errors(ref.sway_m_s, est.sway_m_s, false),
           errors(ref.heading_rad, est.heading_rad, true)};
+}
+
+BasinTable basin_table(const PlanarReference& ref, const std::vector<TimeNs>& t,
+                       const PlanarStates& est, TimeNs tolerance_ns, std::size_t* pairs) {
+  DRIFTLAB_DEMAND(t.size() == est.north_m.size());
+  std::array<std::vector<double>, 5> d;
+  std::size_t paired = 0;
+  for (std::size_t i = 0; i < ref.t_ns.size(); ++i) {
+    const auto it = std::lower_bound(t.begin(), t.end(), ref.t_ns[i]);
+    std::size_t j = static_cast<std::size_t>(it - t.begin());
+    if (j > 0 && (j == t.size() || ref.t_ns[i] - t[j - 1] < t[j] - ref.t_ns[i])) --j;
+    if (j >= t.size() || std::abs(t[j] - ref.t_ns[i]) > tolerance_ns) continue;
+    ++paired;
+    const std::array<std::pair<double, double>, 5> q{
+        {{ref.states.north_m[i], est.north_m[j]},
+         {ref.states.east_m[i], est.east_m[j]},
+         {ref.states.surge_m_s[i], est.surge_m_s[j]},
+         {ref.states.sway_m_s[i], est.sway_m_s[j]},
+         {ref.states.heading_rad[i], est.heading_rad[j]}}};
+    for (std::size_t k = 0; k < 5; ++k) {
+      const auto [r, e] = q[k];
+      if (!std::isfinite(r)) continue;
+      d[k].push_back(k == 4 ? rad2deg(wrap_angle_rad(e - r)) : e - r);
+    }
+  }
+  if (pairs) *pairs = paired;
+  return {summarize(d[0]), summarize(d[1]), summarize(d[2]), summarize(d[3]), summarize(d[4])};
 }
 
 }  // namespace driftlab::eval

@@ -62,4 +62,17 @@ PlanarStates planar_states(const std::vector<TimeNs>& t_ns, const std::vector<SE
 
 BasinTable basin_table(const PlanarStates& reference, const PlanarStates& estimate);
 
+/// A reference of planar states at times of its own (the basin's overhead camera): a quantity
+/// it could not measure at a time is NaN there.
+struct PlanarReference {
+  std::vector<TimeNs> t_ns;  ///< sorted
+  PlanarStates states;
+};
+
+/// The basin table of `estimate` (at the sorted times `t_ns`) against `reference`: each
+/// reference time is paired with the nearest estimate within `tolerance_ns`, and each quantity
+/// counts the pairs where the reference has it. `pairs`: the paired times.
+BasinTable basin_table(const PlanarReference& reference, const std::vector<TimeNs>& t_ns,
+                       const PlanarStates& estimate, TimeNs tolerance_ns, std::size_t* pairs);
+
 }  // namespace driftlab::eval

@@ -20,6 +20,7 @@
 #include "pipeline/external_vo.hpp"
 #include "pipeline/filter_stage.hpp"
 #include "pipeline/frame_source.hpp"
+#include "pipeline/overhead_stage.hpp"
 #include "pipeline/progress.hpp"
 #include "pipeline/render_stage.hpp"
 #include "pipeline/scenario_checks.hpp"
@@ -252,8 +253,9 @@ std::vector<Track> make_tracks(const Scenario& sc, const StereoRig& rig,
 // VO's inliers and depths as the section covariates): metrics.json's algorithms and VO
 // timings, and the tables; each track's sections CSV is appended to *sections.
 std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks,
-                            const MissionTruth& mission, TrackRecords* records,
-                            std::string* sections_csv) {
+                            const MissionTruth& mission,
+                            const std::optional<eval::PlanarReference>& overhead,
+                            TrackRecords* records, std::string* sections_csv) {
   const Trajectory& camera_gt = mission.camera_gt;
   const std::vector<EulerZYX>& platform = mission.platform;
   std::string report;
@@ -268,6 +270,7 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
     in.est_label = "estimates/" + tr.name + ".tum";
     in.algorithm = tr.name;
     in.options = sc.eval;
+    in.basin_reference = overhead;
     eval::FrameTable ft;
     // `lost`: 1 where the VO gave no motion, so each section's mean is its share of such
     // frames (the sections a lost stretch touched). The frames the camera delivered, as in
@@ -505,10 +508,19 @@ static VisionRecord run_vision_stages(const Scenario& sc, const sim::SceneGeomet
                        &warnings);
   write_estimates(tracks, dir);
 
-  // Stage: evaluation of every estimate against the camera ground truth.
+  // Stage: the basin paper's reference, when the overhead camera is on.
+  std::optional<eval::PlanarReference> overhead;
+  if (sc.sensors.overhead.enabled) {
+    OverheadResult o = run_overhead_camera(sc, scene, mission, dir);
+    record.overhead = o.record;
+    overhead = planar_reference(o.reference);
+  }
+
+  // Stage: evaluation of every estimate against the camera ground truth (and the overhead
+  // camera's reference).
   std::string report = fmt::format("# driftlab run: {}\n\n{}\n\n", sc.name, sc.description);
   std::string sections;
-  report += evaluate_tracks(sc, tracks, mission, &record.tracks, &sections);
+  report += evaluate_tracks(sc, tracks, mission, overhead, &record.tracks, &sections);
   write_file_atomic(dir / "sections.csv", sections);
   report += report_tracking(tracks, camera_gt, &record.tracks, &warnings);
   report += compare_filters_with_raw_vo(tracks, &record.tracks, &warnings);

@@ -30,6 +30,13 @@ void TrackRecords::add_to(nlohmann::json* metrics) const {
   }
 }
 
+void OverheadRecord::add_to(nlohmann::json* metrics) const {
+  (*metrics)["overhead"] = {{"frames", frames},       {"tracked", tracked},
+                            {"render_s", render_s},   {"track_s", track_s},
+                            {"plane_z_m", plane_z_m}, {"reference", reference_file},
+                            {"frame", frame_file}};
+}
+
 void VisionRecord::add_to(nlohmann::json* metrics) const {
   nlohmann::json& m = *metrics;
   m["timing"]["threads"] = threads;
@@ -52,6 +59,7 @@ void VisionRecord::add_to(nlohmann::json* metrics) const {
   m["render"] = {{"context", render_context}, {"assets", assets}, {"triangles", triangles}};
   tracks.add_to(metrics);
   for (const auto& [name, record] : external_vo) m["external_vo"][name] = record;
+  if (overhead) overhead->add_to(metrics);
   m["warnings"] = warnings;
 }
 

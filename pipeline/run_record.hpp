@@ -69,6 +69,17 @@ struct CameraRecord {
   double right_offset_jitter_ms = 0;
 };
 
+/// What the overhead stage did (metrics.json overhead).
+struct OverheadRecord {
+  std::size_t frames = 0;
+  std::size_t tracked = 0;  ///< frames where both markers were found
+  double render_s = 0, track_s = 0;
+  double plane_z_m = 0;  ///< the height the pixels are mapped onto (the markers' at rest)
+  std::string reference_file = "overhead_reference.csv";
+  std::string frame_file = "overhead_frame.png";
+  void add_to(nlohmann::json* metrics) const;  ///< metrics.json overhead
+};
+
 /// The render, VO, fusion and evaluation stages of a scenario run, when they ran.
 struct VisionRecord {
   /// Writes its blocks (timing's render and VO entries, camera, frame_cache, render,
@@ -84,6 +95,7 @@ struct VisionRecord {
   std::size_t triangles = 0;
   TrackRecords tracks;
   std::map<std::string, nlohmann::json> external_vo;  ///< each external VO's fate
+  std::optional<OverheadRecord> overhead;             ///< the basin's overhead camera
   std::vector<std::string> warnings;
 };
 

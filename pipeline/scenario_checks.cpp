@@ -159,6 +159,16 @@ void check_mission(const Scenario& s, std::vector<yaml::Problem>* out) {
   }
 }
 
+// The overhead camera hangs from a wave basin's ceiling.
+void check_overhead(const Scenario& s, std::vector<yaml::Problem>* out) {
+  if (s.sensors.overhead.enabled && s.scene.type != scenes::SceneType::kWaveBasin)
+    out->push_back({"sensors.overhead.enabled",
+                    fmt::format("sensors.overhead.enabled with scene.type: got true with {}, "
+                                "expected scene.type wave_basin (the camera hangs from the "
+                                "basin's ceiling)",
+                                yaml::enum_name(s.scene.type))});
+}
+
 }  // namespace
 
 std::vector<yaml::Problem> impossible_combinations(const Scenario& scenario) {
@@ -166,6 +176,7 @@ std::vector<yaml::Problem> impossible_combinations(const Scenario& scenario) {
   check_waves(scenario, &out);
   check_hull(scenario, &out);
   check_mission(scenario, &out);
+  check_overhead(scenario, &out);
   return out;
 }
 

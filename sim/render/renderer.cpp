@@ -40,7 +40,8 @@ struct GpuMesh {
   GLuint vao = 0, vbo = 0, ebo = 0;
   GLsizei count = 0;
   Material material;
-  Eigen::Vector3f centre = Eigen::Vector3f::Zero();  // bounding sphere, world
+  bool on_body = false;                              // Mesh::on_body
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();  // bounding sphere, mesh frame
   float radius = 0;
 };
 
@@ -82,6 +83,8 @@ struct StereoRenderer::Impl {
   StereoRig rig;
   SE3 T_left_right;  // the true right camera (defaults to the rig's baseline)
   RenderOptions options;
+  bool colour = false;                                  // ImageKind::kColour
+  Eigen::Matrix4f T_W_B = Eigen::Matrix4f::Identity();  // where body meshes are drawn
   std::unique_ptr<GlContext> context;
   std::unique_ptr<MipChain> mip_chain;  // the mirror image's blur levels under wind ripples
   // Programs by variant: [mode][sun] with mode 0 gray, 1 linear depth.
@@ -127,8 +130,11 @@ struct StereoRenderer::Impl {
   void build_eye_targets(EyeTargets* e);
   void color_target_(GLuint* fbo, GLuint* tex, unsigned format, GLuint* depth_rb, int W, int H,
                      int levels = 1);
-  // A colour (R8) and depth renderbuffer pair with `samples` samples (1: single-sampled).
-  void multisample_target_(GLuint* fbo, GLuint* color, GLuint* depth, int samples, int W, int H);
+  // A colour (`format`) and depth renderbuffer pair with `samples` samples (1: single-sampled).
+  void multisample_target_(GLuint* fbo, GLuint* color, GLuint* depth, unsigned format, int samples,
+                           int W, int H);
+  // The eyes' colour format: R8 gray, RGBA8 colour.
+  unsigned eye_format() const { return colour ? GL_RGBA8 : GL_R8; }
   void draw_scene(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, float mirror, int mode);
   void draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, double t, int mode,
                   GLuint reflection);  // 0: none
@@ -148,7 +154,7 @@ struct StereoRenderer::Impl {
   DepthImage render_depth(const SE3& T_W_C, double t);
 };
 
-StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& options)
+StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& options, ImageKind kind)
     : impl_(std::make_unique<Impl>()) {
   const std::string problems = validate(rig);
   if (!problems.empty()) throw UserError("renderer: invalid stereo rig: " + problems);
@@ -156,10 +162,13 @@ StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& option
   impl_->rig = rig;
   impl_->T_left_right = rig.T_left_right();
   impl_->options = options;
+  impl_->colour = kind == ImageKind::kColour;
   impl_->context = create_gl_context(options.backend);
+  const std::string colour = fmt::format("#define COLOUR {}\n", impl_->colour ? 1 : 0);
   for (int mode : {0, 1})
     for (int sun : {0, 1}) {
-      const std::string defines = fmt::format("#define DEPTH {}\n#define SUN {}\n", mode, sun);
+      const std::string defines =
+          fmt::format("#define DEPTH {}\n#define SUN {}\n", mode, sun) + colour;
       impl_->scene_progs[mode][sun] =
           link_program(shaders::kSceneVs, shaders::kSceneFs, "scene", defines);
       for (int ripples : {0, 1})
@@ -168,8 +177,8 @@ StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& option
                          defines + fmt::format("#define RIPPLES {}\n", ripples));
     }
   for (int sun : {0, 1})
-    impl_->sky_progs[sun] =
-        link_program(shaders::kSkyVs, shaders::kSkyFs, "sky", fmt::format("#define SUN {}\n", sun));
+    impl_->sky_progs[sun] = link_program(shaders::kSkyVs, shaders::kSkyFs, "sky",
+                                         fmt::format("#define SUN {}\n", sun) + colour);
   glGenVertexArrays(1, &impl_->empty_vao);
   impl_->mip_chain = std::make_unique<MipChain>();
   impl_->proj = projection_from_intrinsics(rig.camera, kNear, kFar);
@@ -270,9 +279,9 @@ void StereoRenderer::Impl::build_framebuffers() {
 void StereoRenderer::Impl::build_eye_targets(EyeTargets* e) {
   const int W = rig.camera.width, H = rig.camera.height;
   const int samples = options.msaa_samples;
-  multisample_target_(&e->msaa_fbo, &e->msaa_color, &e->msaa_depth, samples, W, H);
+  multisample_target_(&e->msaa_fbo, &e->msaa_color, &e->msaa_depth, eye_format(), samples, W, H);
 
-  color_target_(&e->resolve_fbo, &e->resolve_tex, GL_R8, nullptr, W, H);
+  color_target_(&e->resolve_fbo, &e->resolve_tex, eye_format(), nullptr, W, H);
   // The reflection pass (render.reflection_resolution): at full resolution
   // by default; at half resolution it costs a quarter of the fill, but its
   // edges snap the mirror image's sub-pixel motion to steps of two pixels,
@@ -282,17 +291,17 @@ void StereoRenderer::Impl::build_eye_targets(EyeTargets* e) {
   refl_levels = mip_level_count(RW, RH);
   color_target_(&e->refl_fbo, &e->refl_tex, GL_R8, &e->refl_depth, RW, RH, refl_levels);
   if (options.reflection_msaa_samples > 1)
-    multisample_target_(&e->refl_msaa_fbo, &e->refl_msaa_color, &e->refl_msaa_depth,
+    multisample_target_(&e->refl_msaa_fbo, &e->refl_msaa_color, &e->refl_msaa_depth, GL_R8,
                         options.reflection_msaa_samples, RW, RH);
 }
 
 void StereoRenderer::Impl::multisample_target_(GLuint* fbo, GLuint* color, GLuint* depth,
-                                               int samples, int W, int H) {
+                                               unsigned format, int samples, int W, int H) {
   glGenFramebuffers(1, fbo);
   glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
   glGenRenderbuffers(1, color);
   glBindRenderbuffer(GL_RENDERBUFFER, *color);
-  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, GL_R8, W, H);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, format, W, H);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, *color);
   glGenRenderbuffers(1, depth);
   glBindRenderbuffer(GL_RENDERBUFFER, *depth);
@@ -339,7 +348,8 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
   // validation on this thread; the squares keep culling useful on long reaches.
   constexpr float kBatchCell_m = 50.f;
   std::vector<Mesh> merged;
-  std::map<std::tuple<int, float, float, bool, long, long>, std::size_t> batch_of;
+  std::map<std::tuple<int, float, float, bool, long, long, bool, std::array<float, 3>>, std::size_t>
+      batch_of;
   for (const Mesh& x : scene.meshes) {
     if (x.indices.empty()) continue;
     for (std::uint32_t i : x.indices)
@@ -351,10 +361,10 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
       hi = hi.cwiseMax(Eigen::Vector3f(v.x, v.y, v.z));
     }
     const Eigen::Vector3f c = 0.5f * (lo + hi);
-    const auto key =
-        std::make_tuple(x.material.texture, x.material.albedo, x.material.specular,
-                        x.material.double_sided, std::lround(std::floor(c.x() / kBatchCell_m)),
-                        std::lround(std::floor(c.y() / kBatchCell_m)));
+    const auto key = std::make_tuple(
+        x.material.texture, x.material.albedo, x.material.specular, x.material.double_sided,
+        std::lround(std::floor(c.x() / kBatchCell_m)),
+        std::lround(std::floor(c.y() / kBatchCell_m)), x.on_body, x.material.colour);
     const auto [it, fresh] = batch_of.emplace(key, merged.size());
     if (fresh) {
       merged.push_back(x);
@@ -370,6 +380,7 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
       throw InternalError(fmt::format("renderer: mesh '{}' names a missing texture", mesh.name));
     GpuMesh g;
     g.material = mesh.material;
+    g.on_body = mesh.on_body;
     g.count = static_cast<GLsizei>(mesh.indices.size());
     Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = -lo;
     for (const Vertex& v : mesh.vertices) {
@@ -494,7 +505,9 @@ void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::
   draw_order.clear();
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     const GpuMesh& g = meshes[i];
-    const Eigen::Vector3f c(g.centre.x(), g.centre.y(), g.centre.z() * mirror);
+    const Eigen::Vector3f w =
+        g.on_body ? (T_W_B * g.centre.homogeneous()).head<3>().eval() : g.centre;
+    const Eigen::Vector3f c(w.x(), w.y(), w.z() * mirror);
     if (!sphere_visible(planes, c, g.radius)) continue;
     draw_order.emplace_back(std::max(0.f, (c - eye_m).norm() - g.radius), i);
   }
@@ -518,6 +531,8 @@ void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::
       glBindTexture(GL_TEXTURE_2D, textures[static_cast<std::size_t>(g.material.texture)]);
     glUniform1f(loc(scene_prog, "u_albedo"), g.material.albedo);
     glUniform1f(loc(scene_prog, "u_specular"), g.material.specular);
+    glUniform3fv(loc(scene_prog, "u_tint"), 1, g.material.colour.data());
+    set_mat4(scene_prog, "u_model", g.on_body ? T_W_B : Eigen::Matrix4f::Identity().eval());
     glBindVertexArray(g.vao);
     glDrawElements(GL_TRIANGLES, g.count, GL_UNSIGNED_INT, nullptr);
   }
@@ -746,6 +761,31 @@ DepthImage StereoRenderer::Impl::render_depth(const SE3& T_W_C, double t) {
   glReadPixels(0, 0, W, H, GL_RED, GL_FLOAT, d.depth_m.data());
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return d;
+}
+
+void StereoRenderer::set_body_pose(const SE3& T_W_B) {
+  impl_->T_W_B = T_W_B.matrix().cast<float>();
+}
+
+ColourImage StereoRenderer::render_colour(const SE3& T_W_C, double t_s) {
+  Impl& m = *impl_;
+  DRIFTLAB_DEMAND_MSG(m.colour, "render_colour: the renderer draws gray images");
+  m.context->make_current();
+  if (m.reflects()) m.draw_reflection(T_W_C, 0);
+  m.draw_eye(T_W_C, t_s, 0);
+  const Impl::EyeTargets& e = m.eyes[0];
+  const int W = m.rig.camera.width, H = m.rig.camera.height;
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, m.options.msaa_samples > 1 ? e.resolve_fbo : e.msaa_fbo);
+  std::vector<std::uint8_t> rgba(static_cast<std::size_t>(W) * H * 4);
+  glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  ColourImage img;
+  img.width = W;
+  img.height = H;
+  img.bgr.resize(static_cast<std::size_t>(W) * H * 3);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(W) * H; ++i)
+    for (std::size_t c = 0; c < 3; ++c) img.bgr[3 * i + c] = rgba[4 * i + 2 - c];
+  return img;
 }
 
 void StereoRenderer::set_right_camera(const SE3& T_left_right) {

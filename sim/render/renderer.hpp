@@ -59,6 +59,17 @@ struct RowBand {
   int row_end = 0;  // one past the last row
 };
 
+/// An 8-bit colour image, row-major, blue, green, red per pixel (OpenCV's order).
+struct ColourImage {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> bgr;
+};
+
+/// What a renderer's eyes hold: gray (the stereo cameras) or colour (materials tinted by
+/// Material::colour; water, sky and the mirror image stay gray).
+enum class ImageKind { kGray, kColour };
+
 /// Largest number of wave components the water shader sums (the strongest are kept).
 constexpr int kMaxShaderWaveComponents = 32;
 
@@ -66,7 +77,8 @@ class StereoRenderer {
  public:
   /// Creates the GL context of `options.backend`. Throws UserError for an
   /// invalid rig (naming the field) or an unavailable backend.
-  StereoRenderer(const StereoRig& rig, const RenderOptions& options);
+  StereoRenderer(const StereoRig& rig, const RenderOptions& options,
+                 ImageKind kind = ImageKind::kGray);
   ~StereoRenderer();
   StereoRenderer(const StereoRenderer&) = delete;
   StereoRenderer& operator=(const StereoRenderer&) = delete;
@@ -79,6 +91,9 @@ class StereoRenderer {
   /// at each frame's time and shared by both eyes): drawn in the shading only,
   /// not in the geometry or the depth (none when null or empty, the default).
   void set_ripples(std::shared_ptr<RippleMaps> maps);
+  /// Where the body meshes (Mesh::on_body) are drawn: the body (FRD) frame's pose in the
+  /// world (NED). The identity until set.
+  void set_body_pose(const SE3& T_W_B);
   /// Where the right camera really is relative to the left (a miscalibrated
   /// rig: see sim::true_T_left_right); the rig's nominal baseline by default.
   void set_right_camera(const SE3& T_left_right);
@@ -89,6 +104,9 @@ class StereoRenderer {
   /// camera's pose at the right image's times. Without depth.
   StereoImages render_bands(const std::vector<RowBand>& left, const std::vector<RowBand>& right);
 
+  /// Renders the left eye only, in colour, at pose T_W_C and time t_s (a renderer made with
+  /// ImageKind::kColour; InternalError otherwise).
+  ColourImage render_colour(const SE3& T_W_C, double t_s);
   const std::string& context_description() const;
   std::size_t triangles() const;
 

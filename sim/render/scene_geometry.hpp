@@ -3,6 +3,7 @@
 // module builds one of these from the scenario; the renderer uploads it once.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -38,10 +39,18 @@ struct Material {
   // ((b - a) x (c - a) along the normal), as MeshBuilder's are. true: open sheets seen from both
   // sides (reed blades, sheet piling, roofs seen from below).
   bool double_sided = true;
+  // Reflectance by colour channel (linear R, G, B), multiplying the gray shading in colour
+  // images (StereoRenderer's ImageKind::kColour: the basin's overhead camera and its
+  // markers); gray images ignore it.
+  std::array<float, 3> colour{1.0f, 1.0f, 1.0f};
 };
 
 struct Mesh {
   std::string name;
+  // false: vertices in the world frame (NED), fixed. true: in the vessel's body frame (FRD),
+  // drawn at the pose StereoRenderer::set_body_pose gives (the ship model seen from the
+  // basin's overhead camera).
+  bool on_body = false;
   std::vector<Vertex> vertices;
   std::vector<std::uint32_t> indices;  // triangles, 3 per face
   Material material;

@@ -6,7 +6,8 @@
 namespace driftlab::sim::shaders {
 
 // Shaders come in variants chosen by #defines: DEPTH (linear depth instead of
-// gray) and SUN (sun glints, which need per-pixel normals and view vectors).
+// gray), SUN (sun glints, which need per-pixel normals and view vectors) and COLOUR (RGB
+// images: the scene's materials tinted by their colour, water and sky gray).
 // On llvmpipe the cost of a fragment is mostly the interpolation of its
 // inputs, so each variant carries only what it reads: lighting and fog are
 // smooth over a triangle and are evaluated per vertex (Gouraud).
@@ -16,6 +17,7 @@ layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
 uniform mat4 u_view;       // world -> camera (optical)
 uniform mat4 u_proj;
+uniform mat4 u_model;      // mesh -> world: the identity, or the body's pose for a body mesh
 uniform float u_mirror;    // 1: as is; -1: mirrored about the water plane z = 0
 uniform vec3 u_sun_dir;    // towards the sun, world
 uniform float u_ambient;
@@ -32,12 +34,14 @@ out vec3 v_world;
 out vec3 v_normal;
 #endif
 void main() {
-  vec3 p = vec3(a_pos.xy, a_pos.z * u_mirror);
+  vec3 w = (u_model * vec4(a_pos, 1.0)).xyz;
+  vec3 p = vec3(w.xy, w.z * u_mirror);
   vec4 c = u_view * vec4(p, 1.0);
 #if DEPTH
   v_view_z = c.z;
 #else
-  vec3 n = normalize(vec3(a_normal.xy, a_normal.z * u_mirror));
+  vec3 m = mat3(u_model) * a_normal;
+  vec3 n = normalize(vec3(m.xy, m.z * u_mirror));
   // Overcast light comes mostly from above (-z); the sun adds a directional term.
   // Surfaces facing down still get light bounced from the water and ground.
   float sky_light = mix(0.35, 1.0, 0.5 + 0.5 * clamp(-n.z, -1.0, 1.0));
@@ -51,7 +55,7 @@ void main() {
   v_uv_light_fog = vec4(a_uv, light, exp(-length(u_eye - p) / u_fog));
 #endif
   // Mirrored pass: keep only what is above the water (z < 0 before mirroring).
-  gl_ClipDistance[0] = u_mirror < 0.0 ? -a_pos.z : 1.0;
+  gl_ClipDistance[0] = u_mirror < 0.0 ? -w.z : 1.0;
   gl_Position = u_proj * c;
 }
 )";
@@ -70,6 +74,7 @@ uniform sampler2D u_tex;
 uniform bool u_has_tex;
 uniform float u_albedo;
 uniform float u_specular;
+uniform vec3 u_tint;       // the material's colour (COLOUR images only)
 uniform vec3 u_sun_dir;
 uniform float u_sky;
 uniform vec3 u_eye;
@@ -88,7 +93,11 @@ void main() {
     g += u_specular * pow(max(dot(n, h), 0.0), 60.0);
   }
 #endif
+#if COLOUR
+  frag = vec4(mix(vec3(u_sky), g * u_tint, v_uv_light_fog.w), 1.0);
+#else
   frag = vec4(mix(u_sky, g, v_uv_light_fog.w), 0.0, 0.0, 1.0);
+#endif
 #endif
 }
 )";
@@ -120,7 +129,11 @@ void main() {
 #if SUN
   g += 0.35 * pow(max(dot(d, u_sun_dir), 0.0), 200.0);
 #endif
+#if COLOUR
+  frag = vec4(vec3(min(g, 1.0)), 1.0);
+#else
   frag = vec4(min(g, 1.0), 0.0, 0.0, 1.0);
+#endif
 }
 )";
 
@@ -307,7 +320,11 @@ void main() {
   vec3 r = reflect(-normalize(u_eye - v_world), n);
   g += 0.8 * pow(max(dot(r, u_sun_dir), 0.0), 300.0);
 #endif
+#if COLOUR
+  frag = vec4(vec3(mix(u_sky, g, v_shade.w)), 1.0);
+#else
   frag = vec4(mix(u_sky, g, v_shade.w), 0.0, 0.0, 1.0);
+#endif
 #endif
 }
 )";

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/yaml_io.hpp"
+#include "sim/sensors/overhead_options.hpp"
 
 namespace driftlab::sim {
 
@@ -677,6 +678,7 @@ struct SensorOptions {
   ImuOptions imu;
   GpsOptions gps;
   CompassOptions compass;
+  OverheadOptions overhead;
 
   template <class A>
   void visit(A& a) {
@@ -684,6 +686,9 @@ struct SensorOptions {
     a("imu", imu, "Inertial measurement unit");
     a("gps", gps, "GPS receiver");
     a("compass", compass, "Compass / magnetometer");
+    a("overhead", overhead,
+      "The basin's overhead camera and the model's colour markers: the basin paper's "
+      "reference (Section 3.2)");
   }
 };
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "core/rotation.hpp"
@@ -96,6 +97,39 @@ TEST(Track, PlanarStatesOfACircle) {
   EXPECT_NEAR(b.heading_deg.rmse, rad2deg(0.01), 1e-9);
   EXPECT_NEAR(b.north_m.rmse, 0.02, 1e-12);
   EXPECT_NEAR(b.north_m.sd_sample, 0.0, 1e-12);
+}
+
+// The table against a reference at its own times equals the table against the same states
+// paired index by index (a second method), and the pairing skips what the reference lacks.
+TEST(Track, BasinTableAgainstAReferenceAtItsOwnTimes) {
+  std::vector<TimeNs> t;
+  std::vector<SE3> T;
+  for (int i = 0; i < 50; ++i) {
+    t.push_back(seconds_to_ns(0.05 * i));
+    T.push_back(SE3(quat_from_euler_zyx({0, 0, 0.01 * i}), Vec3(0.15 * 0.05 * i, 0.001 * i, 0)));
+  }
+  const PlanarStates truth = planar_states(t, T, false);
+  PlanarStates est = truth;
+  for (std::size_t i = 0; i < est.north_m.size(); ++i) {
+    est.north_m[i] += 0.01 * std::sin(0.3 * i);
+    est.heading_rad[i] += 0.002 * std::cos(0.2 * i);
+  }
+  const BasinTable direct = basin_table(truth, est);
+  PlanarReference ref{t, truth};
+  for (auto& s : ref.t_ns) s += 3'000'000;  // 3 ms late: still the same frames
+  std::size_t pairs = 0;
+  const BasinTable paired = basin_table(ref, t, est, 10'000'000, &pairs);
+  EXPECT_EQ(pairs, t.size());
+  EXPECT_NEAR(paired.north_m.rmse, direct.north_m.rmse, 1e-15);
+  EXPECT_NEAR(paired.heading_deg.rmse, direct.heading_deg.rmse, 1e-12);
+  EXPECT_EQ(paired.east_m.n, t.size());
+  // A reference sample without a heading counts for the others; one too far off, for none.
+  ref.states.heading_rad[4] = std::numeric_limits<double>::quiet_NaN();
+  ref.t_ns[7] += 22'000'000;  // halfway between frames 7 and 8: 25 ms from either
+  const BasinTable holes = basin_table(ref, t, est, 20'000'000, &pairs);
+  EXPECT_EQ(pairs, t.size() - 1);
+  EXPECT_EQ(holes.heading_deg.n, t.size() - 2);
+  EXPECT_EQ(holes.north_m.n, t.size() - 1);
 }
 
 TEST(Track, CameraOpticalAxisIsTheHeading) {

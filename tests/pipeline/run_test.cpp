@@ -188,6 +188,18 @@ TEST(Run, SameBytesWhateverTheThreadCountWithARollingShutterAndAFreeRunningPair)
   const auto m = nlohmann::json::parse(slurp(a / "metrics.json"));
   EXPECT_EQ(m["camera"]["shutter"], "rolling");
   EXPECT_NE(m["camera"]["right_offset_ms"].get<double>(), 0.0);
+  // The basin paper's reference (the overhead camera, on in the basin scenarios): the same
+  // bytes too, every frame tracked, and each estimate measured against it as against the
+  // exact truth, the two within the reference's own error of a few millimetres.
+  EXPECT_EQ(slurp(a / "overhead_reference.csv"), slurp(b / "overhead_reference.csv"));
+  EXPECT_EQ(m["overhead"]["tracked"], m["overhead"]["frames"]);
+  for (const auto& [name, algo] : m["algorithms"].items()) {
+    SCOPED_TRACE(name);
+    const auto& o = algo["basin_overhead"];
+    EXPECT_EQ(o["pairs"].get<std::size_t>(), algo["association"]["pairs"].get<std::size_t>());
+    for (const char* q : {"north_m", "east_m"})
+      EXPECT_NEAR(o[q]["rmse"].get<double>(), algo["basin"][q]["rmse"].get<double>(), 0.005) << q;
+  }
   for (const fs::path& d : {a, b}) fs::remove_all(d);
 }
 
