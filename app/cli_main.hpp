@@ -49,6 +49,9 @@ auto as_usage_error(std::string_view flag, F&& f) -> decltype(f()) {
   }
 }
 
+/// `text` into the file `out` (written atomically), or to stdout when `out` is empty.
+void write_or_print(const std::string& text, const std::string& out);
+
 /// CLI11 check of a seed option: a non-negative integer (as the scenario's `seed`).
 inline CLI::Validator seed_check() {
   return CLI::Validator(

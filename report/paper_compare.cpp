@@ -147,11 +147,23 @@ std::string table(const std::vector<std::string>& rows, const std::vector<Column
   return out + "\n";
 }
 
-// The run's algorithms that the paper's columns compare with, in order.
+// The suffix of an algorithm measured at the paper's prism (app/paper_command.hpp).
+constexpr std::string_view kPrism = " (prism)";
+
+bool at_prism(std::string_view a) { return a.ends_with(kPrism); }
+
+// The VO an algorithm's column is: sparse, sparse_kf or dense.
+std::string_view vo_of(std::string_view a) {
+  return at_prism(a) ? a.substr(0, a.size() - kPrism.size()) : a;
+}
+
+// The run's algorithms that the paper's columns compare with, in order: each VO at the camera,
+// then at the prism when the run has it there too.
 std::vector<std::string> twin_algorithms(const nlohmann::json& metrics) {
   std::vector<std::string> out;
-  for (const char* a : {"sparse", "sparse_kf", "dense"})
-    if (!sub(metrics, {"algorithms", a}).is_null()) out.emplace_back(a);
+  for (const std::string a : {"sparse", "sparse_kf", "dense"})
+    for (const std::string& name : {a, a + std::string(kPrism)})
+      if (!sub(metrics, {"algorithms", name}).is_null()) out.push_back(name);
   if (out.empty())
     throw UserError(
         "driftlab paper: the run has none of the algorithms sparse, sparse_kf and dense "
@@ -167,7 +179,7 @@ std::vector<Column> columns(const std::vector<std::string>& twins, PaperCells pa
   for (const PaperColumn& p : kPaper) {
     out.push_back({fmt::format("paper {}", p.algorithm), paper(p)});
     for (const std::string& a : twins) {
-      const bool belongs = std::string(p.algorithm) == "sparse" ? a != "dense" : a == "dense";
+      const bool belongs = (vo_of(a) == "dense") == (std::string_view(p.algorithm) == "dense");
       if (belongs) out.push_back({fmt::format("twin {}", a), twin(a)});
     }
   }
@@ -344,14 +356,14 @@ std::string findings(const nlohmann::json& m, const std::vector<std::string>& tw
         "({} against {} m/m).\n",
         ep("sparse") < ep("dense") ? "yes" : "no", num(ep("sparse")), num(ep("dense")));
   for (const std::string& a : twins) {
-    if (a == "sparse_kf") continue;
+    if (vo_of(a) == "sparse_kf") continue;
     const auto& r = sub(m, {"algorithms", a, "regression", "coefficients"});
     auto significant = [&](const char* term) {
       const double p = at(r, {term, "p"});
       return std::isfinite(p) ? (p < 0.05 ? "significant" : "not significant") : "not fitted";
     };
     out += fmt::format("- {} (Table 3): paper finds {}; twin: h {}, d {}, v {}.\n", a,
-                       a == "sparse" ? "h and d significant" : "v and d significant",
+                       vo_of(a) == "sparse" ? "h and d significant" : "v and d significant",
                        significant("h"), significant("d"), significant("v"));
   }
   return out + "\n";
@@ -359,17 +371,17 @@ std::string findings(const nlohmann::json& m, const std::vector<std::string>& tw
 
 // Where the twin's truth was measured, when not at the camera (eval.reference_point_m): the
 // paper's truth was a prism the total station tracked, not its camera.
-std::string reference_point_note(const nlohmann::json& algorithm) {
+std::string reference_point_note(const nlohmann::json& algorithm, std::string_view whose) {
   const auto it = algorithm.find("association");
   if (it == algorithm.end() || !it->contains("reference_point_m")) return "";
   const std::vector<double> l = (*it)["reference_point_m"].get<std::vector<double>>();
   if (l == std::vector<double>{0.0, 0.0, 0.0}) return "";
   return fmt::format(
-      "The twin's truth is measured {:.2f} m from its camera, at [{}, {}, {}] m in the camera's "
-      "frame (x right, y down, z forward; `eval.reference_point_m`), as the paper's total station "
-      "tracked a prism on the vessel; the estimates are the camera's, with no lever-arm "
-      "correction.\n\n",
-      std::hypot(l[0], l[1], l[2]), l[0], l[1], l[2]);
+      "{} truth is measured {:.2f} m from its camera, at [{}, {}, {}] m in the camera's "
+      "frame (x right, y down, z forward; `eval.reference_point_m`, `driftlab paper --prism`), "
+      "as the paper's total station tracked a prism on the vessel; the estimates are the "
+      "camera's, with no lever-arm correction.\n\n",
+      whose, std::hypot(l[0], l[1], l[2]), l[0], l[1], l[2]);
 }
 
 }  // namespace
@@ -390,7 +402,12 @@ std::string river_paper_side_by_side(const nlohmann::json& metrics, RiverPaperTr
       num(at(sub(metrics, {"algorithms", twins.front()}), {"sections", "count"}), "{:.0f}"),
       num(at(sub(metrics, {"algorithms", twins.front()}), {"sections", "section_length_m"}),
           "{:.1f}"));
-  out += reference_point_note(sub(metrics, {"algorithms", twins.front()}));
+  out += reference_point_note(sub(metrics, {"algorithms", twins.front()}), "The twin's");
+  for (const std::string& a : twins)
+    if (at_prism(a)) {
+      out += reference_point_note(sub(metrics, {"algorithms", a}), "In the (prism) columns the");
+      break;
+    }
   out += table1(metrics, twins);
   out += table2(metrics, twins, track);
   out += table3(metrics, twins);

@@ -488,6 +488,17 @@ TEST(Cli, PaperPutsTheRiverPaperBesideARunAndAsksForTheTrackOfOtherScenarios) {
   const std::string text = slurp(dir / "paper.md");
   EXPECT_NE(text.find("| Mean | 0.067 | 0.012 | 0.177 |"), std::string::npos) << text;
   EXPECT_NE(text.find("13.36 (2.01)"), std::string::npos);
+  // A metrics.json without its run's files: the camera's columns, and a warning for the prism's.
+  EXPECT_NE(r.err.find("warning: no columns at the prism: " + dir.string() +
+                       " lacks scenario.resolved.yaml, groundtruth.tum, frames.csv"),
+            std::string::npos)
+      << r.err;
+  r = run_cli({"paper", dir.string(), "--track", "total", "--prism", "none"});
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  r = run_cli({"paper", dir.string(), "--track", "total", "--prism", "0,0"});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.err.find("--prism 0,0"), std::string::npos) << r.err;
   r = run_cli({"paper", (dir / "missing").string()});
   EXPECT_EQ(r.exit_code, 1) << r.output;
   fs::remove_all(dir);

@@ -91,6 +91,37 @@ TEST(PaperCompare, SaysWhereTheTruthWasMeasuredWhenNotAtTheCamera) {
       << prism;
 }
 
+// With each VO also measured at the prism (`driftlab paper` adds "NAME (prism)"), its column
+// stands beside the camera's, in the VO's own group, and the findings name both.
+TEST(PaperCompare, TheTwinAtTheCameraAndAtThePrismSideBySide) {
+  nlohmann::json m;
+  m["scenario"] = "river_survey";
+  m["algorithms"]["sparse"] = algorithm(0.0041, 0.6);
+  m["algorithms"]["sparse (prism)"] = algorithm(0.0780, 0.001);
+  m["algorithms"]["sparse (prism)"]["association"]["reference_point_m"] = {-0.35, -0.55, 0.606};
+  m["algorithms"]["dense"] = algorithm(0.0082, 0.5);
+  m["algorithms"]["dense (prism)"] = algorithm(0.0800, 0.002);
+  const std::string md = river_paper_side_by_side(m, RiverPaperTrack::kTotal);
+  EXPECT_NE(md.find("| paper sparse | twin sparse | twin sparse (prism) | paper dense | twin dense "
+                    "| twin dense (prism) |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| Mean | 0.067 | 0.004 | 0.078 | 0.177 | 0.008 | 0.080 |"), std::string::npos)
+      << md;
+  EXPECT_NE(md.find("In the (prism) columns the truth is measured 0.89 m from its camera, at "
+                    "[-0.35, -0.55, 0.606] m"),
+            std::string::npos)
+      << md;
+  EXPECT_EQ(md.find("The twin's truth is measured"), std::string::npos);
+  EXPECT_NE(md.find("- sparse (prism) (Table 3): paper finds h and d significant; twin: h "
+                    "significant"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("- sparse (Table 3): paper finds h and d significant; twin: h not significant"),
+            std::string::npos)
+      << md;
+}
+
 TEST(PaperCompare, TracksOfTheTwinScenariosAndARunWithoutTheAlgorithms) {
   EXPECT_EQ(river_paper_track_of("river_crossing"), RiverPaperTrack::kDischarge);
   EXPECT_EQ(river_paper_track_of("river_survey"), RiverPaperTrack::kTotal);
