@@ -46,8 +46,8 @@ void add_prism_columns(const fs::path& run_dir, const std::array<double, 3>& pri
     if (!(*metrics)["algorithms"].contains(a)) continue;
     eval::EvaluationInput in;
     in.gt = gt;
-    in.est = read_trajectory(run_dir / "estimates" / (std::string(a) + ".tum"),
-                             TrajectoryFormat::kTum);
+    in.est =
+        read_trajectory(run_dir / "estimates" / (std::string(a) + ".tum"), TrajectoryFormat::kTum);
     in.algorithm = a;
     in.options = sc.eval;
     in.options.reference_point_m = prism;
@@ -68,8 +68,7 @@ int paper_command(const std::vector<std::string>& runs, const std::string& track
     all.push_back(gate::read_results_metrics(files.back()));
   }
   if (report::basin_paper_experiment_of(all.front().value("scenario", std::string()))) {
-    if (!track_name.empty())
-      throw UsageError("--track: the basin paper has no tracks to choose");
+    if (!track_name.empty()) throw UsageError("--track: the basin paper has no tracks to choose");
     write_or_print(report::basin_paper_side_by_side(all), out);
     return kExitOk;
   }

@@ -77,7 +77,7 @@ struct OverheadRecord {
   double plane_z_m = 0;  ///< the height the pixels are mapped onto (the markers' at rest)
   std::string reference_file = "overhead_reference.csv";
   std::string frame_file = "overhead_frame.png";
-  void add_to(nlohmann::json* metrics) const;  ///< metrics.json overhead
+  void add_to(nlohmann::json* metrics) const;  ///< metrics.json overhead and its timing
 };
 
 /// The render, VO, fusion and evaluation stages of a scenario run, when they ran.

@@ -192,7 +192,16 @@ TEST(Run, SameBytesWhateverTheThreadCountWithARollingShutterAndAFreeRunningPair)
   // bytes too, every frame tracked, and each estimate measured against it as against the
   // exact truth, the two within the reference's own error of a few millimetres.
   EXPECT_EQ(slurp(a / "overhead_reference.csv"), slurp(b / "overhead_reference.csv"));
+  EXPECT_EQ(slurp(a / "overhead_frame.png"), slurp(b / "overhead_frame.png"));
   EXPECT_EQ(m["overhead"]["tracked"], m["overhead"]["frames"]);
+  EXPECT_GT(m["timing"]["overhead_render_s"].get<double>(), 0.0);
+  // Its block, and each algorithm's basin_overhead, the same whatever the threads.
+  auto untimed = [](const fs::path& d) {
+    auto j = nlohmann::json::parse(slurp(d / "metrics.json"));
+    j.erase("timing");
+    return j.dump();
+  };
+  EXPECT_EQ(untimed(a), untimed(b));
   for (const auto& [name, algo] : m["algorithms"].items()) {
     SCOPED_TRACE(name);
     const auto& o = algo["basin_overhead"];
