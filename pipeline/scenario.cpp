@@ -232,3 +232,12 @@ std::string scenario_reference_markdown() {
 }
 
 }  // namespace driftlab::pipeline
+
+namespace driftlab::yaml {
+template void read_into<pipeline::Scenario>(const YAML::Node&, const Source&, pipeline::Scenario*,
+                                            bool);
+template std::string to_yaml<pipeline::Scenario>(const pipeline::Scenario&, bool);
+template std::vector<Problem> validation_problems<pipeline::Scenario>(const pipeline::Scenario&,
+                                                                      const std::string&);
+template std::vector<SchemaRow> schema_of<pipeline::Scenario>(const pipeline::Scenario&);
+}  // namespace driftlab::yaml

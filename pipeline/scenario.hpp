@@ -204,3 +204,15 @@ std::string resolved_yaml(const Scenario& scenario);
 std::string scenario_reference_markdown();
 
 }  // namespace driftlab::pipeline
+
+// Each walk over the whole scenario (reading, writing, checking, listing its keys) is compiled
+// once, in scenario.cpp, rather than again in every file that hashes, checks or lists a
+// scenario: about 30 visit() bodies a walk (docs/performance.md, Build and CI).
+namespace driftlab::yaml {
+extern template void read_into<pipeline::Scenario>(const YAML::Node&, const Source&,
+                                                   pipeline::Scenario*, bool);
+extern template std::string to_yaml<pipeline::Scenario>(const pipeline::Scenario&, bool);
+extern template std::vector<Problem> validation_problems<pipeline::Scenario>(
+    const pipeline::Scenario&, const std::string&);
+extern template std::vector<SchemaRow> schema_of<pipeline::Scenario>(const pipeline::Scenario&);
+}  // namespace driftlab::yaml

@@ -4,8 +4,9 @@
 # judges metrics, never settings: each change reaches it only through the VO's results.
 #   pipeline.sparse.lk_refinement=false        no sub-pixel refinement of the matches: must fail
 #   pipeline.sparse.ransac_iterations=8        too few RANSAC iterations: must fail
-#   pipeline.threads=1                         the same bytes, slower: must pass
 #   pipeline.sparse.descriptor_window_px=5     a smaller descriptor window: must pass
+# Output that is the same bytes passes: run-gate.sh itself shows that, against the baseline, on
+# every CI run (so the earlier `pipeline.threads=1` case, a gate run of its own, was dropped).
 # `scripts/test` runs it after run-gate.sh, so the frames come from the frame cache. The same
 # environment as run-gate.sh (DRIFTLAB, SWEEP, BASELINE, JOBS, DRIFTLAB_FRAME_CACHE).
 set -uo pipefail
@@ -37,7 +38,6 @@ expect() {  # expect EXIT "KEY=VALUE"
 
 expect 5 pipeline.sparse.lk_refinement=false
 expect 5 pipeline.sparse.ransac_iterations=8
-expect 0 pipeline.threads=1
 expect 0 pipeline.sparse.descriptor_window_px=5
 [ "$failures" -eq 0 ] || exit 1
-echo "test-gate: the gate failed both regressions and passed both harmless changes"
+echo "test-gate: the gate failed both regressions and passed the harmless change"
