@@ -28,8 +28,8 @@ double number_or_nan(std::string_view token, const fs::path& path, int line, con
   return parse_number(token, path, line, field);
 }
 
-std::string info_yaml(const ExportCalibration& cal, std::size_t frames, const std::string& format,
-                      const std::string& bag_files) {
+std::string bag_info_yaml(const ExportCalibration& cal, std::size_t frames,
+                          const std::string& format, const std::string& bag_files) {
   return fmt::format(
       "# driftlab export, {}\n"
       "format: {}\n"
@@ -156,7 +156,7 @@ void BagWriter::write_calibration_files() const {
     for (const auto& [name, text] : vins_fusion_files(cal_))
       write_file_atomic(root_ / "vins_fusion" / name, text);
   }
-  write_file_atomic(root_ / "info.yaml", info_yaml(cal_, frames_, format_, bag_files_));
+  write_file_atomic(root_ / "info.yaml", bag_info_yaml(cal_, frames_, format_, bag_files_));
 }
 
 }  // namespace

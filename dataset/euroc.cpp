@@ -60,7 +60,7 @@ std::string imu_yaml(const ImuNoiseModel& m) {
       yaml::format_double(m.accelerometer_random_walk));
 }
 
-std::string info_yaml(const ExportCalibration& cal, std::size_t frames) {
+std::string euroc_info_yaml(const ExportCalibration& cal, std::size_t frames) {
   return fmt::format(
       "# driftlab export, EuRoC/ASL layout\n"
       "format: euroc\n"
@@ -127,7 +127,7 @@ class EurocWriter final : public DatasetWriter {
       move_file(csv, mav_ / (csv.stem().string() + "0") / "data.csv");
     if (fs::exists(mav_ / "imu0" / "data.csv"))
       write_file_atomic(mav_ / "imu0" / "sensor.yaml", imu_yaml(cal_.imu));
-    write_file_atomic(root_ / "info.yaml", info_yaml(cal_, frames_));
+    write_file_atomic(root_ / "info.yaml", euroc_info_yaml(cal_, frames_));
   }
 
  private:

@@ -20,7 +20,7 @@ Eigen::Matrix<double, 3, 4> projection(const PinholeCamera& c, double baseline_m
   return P;
 }
 
-std::string info_yaml(const ExportCalibration& cal, std::size_t frames) {
+std::string kitti_info_yaml(const ExportCalibration& cal, std::size_t frames) {
   return fmt::format(
       "# driftlab export, KITTI odometry layout\n"
       "format: kitti\n"
@@ -79,7 +79,7 @@ class KittiWriter final : public DatasetWriter {
     fs::create_directories(root_ / "poses");
     write_kitti(root_ / "poses" / (cal_.sequence + ".txt"), relative);
     for (const auto& csv : truth.sensor_csvs) move_file(csv, root_ / "sensors" / csv.filename());
-    write_file_atomic(root_ / "info.yaml", info_yaml(cal_, stamps_.size()));
+    write_file_atomic(root_ / "info.yaml", kitti_info_yaml(cal_, stamps_.size()));
   }
 
  private:

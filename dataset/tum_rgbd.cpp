@@ -31,7 +31,7 @@ cv::Mat tum_depth(const cv::Mat& depth_m, std::size_t* beyond) {
   return out;
 }
 
-std::string info_yaml(const ExportCalibration& cal, std::size_t frames, double beyond_share) {
+std::string tum_info_yaml(const ExportCalibration& cal, std::size_t frames, double beyond_share) {
   const PinholeCamera& c = cal.rig.camera;
   return fmt::format(
       "# driftlab export, TUM RGB-D layout (left camera only)\n"
@@ -82,7 +82,7 @@ class TumRgbdWriter final : public DatasetWriter {
     write_tum(root_ / "groundtruth.txt", truth.camera);
     for (const auto& csv : truth.sensor_csvs) move_file(csv, root_ / "sensors" / csv.filename());
     const double share = pixels_ ? static_cast<double>(beyond_) / static_cast<double>(pixels_) : 0;
-    write_file_atomic(root_ / "info.yaml", info_yaml(cal_, frames_, share));
+    write_file_atomic(root_ / "info.yaml", tum_info_yaml(cal_, frames_, share));
   }
 
  private:

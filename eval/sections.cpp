@@ -25,7 +25,7 @@ std::vector<double> unwrap(const std::vector<double>& a) {
   return out;
 }
 
-double mean_of(const std::vector<double>& v) {
+double finite_mean(const std::vector<double>& v) {
   double s = 0;
   std::size_t n = 0;
   for (double x : v)
@@ -277,14 +277,14 @@ std::vector<Section> compute_sections(const std::vector<TimeNs>& t_ns,
     add("roll_sd_deg", attitude_sd_deg("roll_deg", 2));
     if (frames) {
       const char* f_name = frame_column("inliers") ? "inliers" : "valid_depth_px";
-      if (const auto* f = frame_column(f_name)) add("f", mean_of(section_values(*f)));
-      if (const auto* d = frame_column("mean_depth_m")) add("d", mean_of(section_values(*d)));
+      if (const auto* f = frame_column(f_name)) add("f", finite_mean(section_values(*f)));
+      if (const auto* d = frame_column("mean_depth_m")) add("d", finite_mean(section_values(*d)));
       for (std::size_t k = 0; k < frames->names.size(); ++k) {
         const std::string& name = frames->names[k];
         if (name == "yaw_deg" || name == "pitch_deg" || name == "roll_deg" || name == f_name ||
             name == "mean_depth_m")
           continue;
-        add(name, mean_of(section_values(frames->columns[k])));
+        add(name, finite_mean(section_values(frames->columns[k])));
       }
     }
     sections.push_back(std::move(sec));

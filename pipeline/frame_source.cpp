@@ -34,7 +34,9 @@ int run_threads(int requested) {
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
-namespace {
+// The producers of frames (a named namespace: FrameSource::Impl, declared in the header, holds
+// one).
+namespace producers {
 
 // The render stage proper: the renderer, its scene, and the camera effects, all created and
 // used on one thread (a GL context belongs to the thread that made it current).
@@ -162,7 +164,9 @@ struct FillProducer : Producer {
   FrameCacheStatus* status;
 };
 
-}  // namespace
+}  // namespace producers
+
+using namespace producers;
 
 struct FrameSource::Impl {
   const Scenario& sc;

@@ -12,8 +12,6 @@
 namespace driftlab::report {
 namespace {
 
-constexpr double kNa = std::numeric_limits<double>::quiet_NaN();
-
 // One cell of the paper's tables: RMSE (std).
 struct Cell {
   double rmse, sd;
@@ -26,7 +24,7 @@ struct Experiment {
   Row kf, pf;              // Tables 2 and 3
 };
 
-constexpr std::array<Experiment, 7> kPaper{{
+constexpr std::array<Experiment, 7> kBasinPaper{{
     {"calm",
      {{{1.097, 1.213}, {1.608, 1.408}, {0.078, 0.103}, {0.011, 0.014}, {1.387, 1.643}}},
      {{{1.054, 1.125}, {1.630, 1.441}, {0.072, 0.087}, {0.013, 0.017}, {1.400, 1.784}}}},
@@ -56,7 +54,8 @@ constexpr std::array<double, 5> kToPaperUnits{100, 100, 100, 100, 1};  // cm, cm
 
 double number(const nlohmann::json& j, const char* key) {
   const auto it = j.find(key);
-  return it != j.end() && it->is_number() ? it->get<double>() : kNa;
+  return it != j.end() && it->is_number() ? it->get<double>()
+                                          : std::numeric_limits<double>::quiet_NaN();
 }
 
 // A run's row from algorithms.ALGO.TABLE (basin or basin_overhead); nullopt when missing.
@@ -113,8 +112,8 @@ std::string table(const char* title, const std::string& suffix,
   std::string algo;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const int e = exps[i];
-    paper.rows[e] = kf ? kPaper[static_cast<std::size_t>(e - 1)].kf
-                       : kPaper[static_cast<std::size_t>(e - 1)].pf;
+    paper.rows[e] = kf ? kBasinPaper[static_cast<std::size_t>(e - 1)].kf
+                       : kBasinPaper[static_cast<std::size_t>(e - 1)].pf;
     algo = algorithm_ending(runs[i], suffix);
     if (algo.empty()) continue;
     if (auto r = twin_row(runs[i], algo, "basin")) exact.rows[e] = *r;
@@ -127,9 +126,9 @@ std::string table(const char* title, const std::string& suffix,
     for (const Source* s : {&paper, &exact, &overhead}) {
       const auto it = s->rows.find(e);
       if (it == s->rows.end()) continue;
-      out +=
-          fmt::format("| {} | {} | {} |{}\n", e, kPaper[static_cast<std::size_t>(e - 1)].conditions,
-                      s->label, cells(it->second));
+      out += fmt::format("| {} | {} | {} |{}\n", e,
+                         kBasinPaper[static_cast<std::size_t>(e - 1)].conditions, s->label,
+                         cells(it->second));
     }
   out += "\nWhich experiment is hardest, by RMSE:\n\n| against | N | E | ψ |\n|---|---|---|---|\n";
   for (const Source* s : {&paper, &exact, &overhead})

@@ -20,7 +20,7 @@ namespace driftlab::report {
 
 namespace {
 
-std::string num(double v) { return std::isfinite(v) ? yaml::format_double(v) : "NaN"; }
+std::string yaml_num(double v) { return std::isfinite(v) ? yaml::format_double(v) : "NaN"; }
 
 // Euler ZYX [deg] of the camera with FRD axes (x along the optical axis): the attitude a
 // reader compares with the platform's (river paper Fig. 7).
@@ -37,8 +37,9 @@ std::string trajectory_dat(const Trajectory& tr, const Trajectory* gt) {
     double err = NAN;
     if (gt != nullptr && k < gt->size() && (*gt)[k].t_ns == tr[k].t_ns)
       err = (p - (*gt)[k].T_W_C.translation()).norm();
-    s += fmt::format("{} {} {} {} {} {} {} {}\n", num(ns_to_seconds(tr[k].t_ns)), num(p.x()),
-                     num(p.y()), num(p.z()), num(e.x()), num(e.y()), num(e.z()), num(err));
+    s += fmt::format("{} {} {} {} {} {} {} {}\n", yaml_num(ns_to_seconds(tr[k].t_ns)),
+                     yaml_num(p.x()), yaml_num(p.y()), yaml_num(p.z()), yaml_num(e.x()),
+                     yaml_num(e.y()), yaml_num(e.z()), yaml_num(err));
   }
   return s;
 }
@@ -164,7 +165,8 @@ std::string least_squares_curve(const std::vector<std::array<double, 2>>& pts) {
   }
   if (pts.size() >= 3 && sxx > 1e-12 * (1 + mx * mx) * static_cast<double>(pts.size())) {
     const double b = sxy / sxx, a = my - b * mx;
-    return fmt::format(", {} + {} * x with lines lw 2 title 'least squares'", num(a), num(b));
+    return fmt::format(", {} + {} * x with lines lw 2 title 'least squares'", yaml_num(a),
+                       yaml_num(b));
   }
   return "";
 }

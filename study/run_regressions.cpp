@@ -15,10 +15,6 @@ namespace driftlab::study {
 
 namespace {
 
-nlohmann::ordered_json jnum(double v) {
-  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
-}
-
 // The value of a --regress metric in one run: a run metric by name, else a key path.
 double regression_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
                                const std::string& metric) {
@@ -114,19 +110,19 @@ double json_number(const nlohmann::json& j, const std::string& dotted) {
 // the fit's paragraph).
 void append_ols(const eval::OlsResult& r, nlohmann::ordered_json* j, std::string* md) {
   (*j)["n"] = r.n;
-  (*j)["r2"] = jnum(r.r2);
-  (*j)["adj_r2"] = jnum(r.adj_r2);
-  (*j)["f"] = jnum(r.f);
-  (*j)["f_p"] = jnum(r.f_p);
-  (*j)["sigma"] = jnum(r.sigma);
+  (*j)["r2"] = finite_or_null(r.r2);
+  (*j)["adj_r2"] = finite_or_null(r.adj_r2);
+  (*j)["f"] = finite_or_null(r.f);
+  (*j)["f_p"] = finite_or_null(r.f_p);
+  (*j)["sigma"] = finite_or_null(r.sigma);
   (*j)["coefficients"] = nlohmann::ordered_json::object();
   *md += "| term | estimate | std. error | t | p | VIF |\n|---|---|---|---|---|---|\n";
   for (const auto& c : r.coefficients) {
-    (*j)["coefficients"][c.name] = {{"estimate", jnum(c.estimate)},
-                                    {"std_error", jnum(c.std_error)},
-                                    {"t", jnum(c.t)},
-                                    {"p", jnum(c.p)},
-                                    {"vif", jnum(c.vif)},
+    (*j)["coefficients"][c.name] = {{"estimate", finite_or_null(c.estimate)},
+                                    {"std_error", finite_or_null(c.std_error)},
+                                    {"t", finite_or_null(c.t)},
+                                    {"p", finite_or_null(c.p)},
+                                    {"vif", finite_or_null(c.vif)},
                                     {"significant", c.significant}};
     *md += fmt::format("| {}{} | {:.4g} | {:.3g} | {:.3g} | {:.3g} | {} |\n", c.name,
                        c.significant ? " *" : "", c.estimate, c.std_error, c.t, c.p,

@@ -55,15 +55,15 @@ const std::vector<RunMetric>& run_metrics() {
   return metrics;
 }
 
+nlohmann::ordered_json finite_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
+}
+
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string num(double v) { return std::isfinite(v) ? yaml::format_double(v) : std::string(); }
-
-nlohmann::ordered_json jnum(double v) {
-  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
-}
 
 struct Table {
   std::vector<std::string> header;
@@ -121,10 +121,10 @@ Stat stat_of(const std::vector<double>& values) {
 
 nlohmann::ordered_json stat_json(const Stat& s) {
   return {{"n", s.n},
-          {"mean", jnum(s.mean)},
-          {"sd", jnum(s.sd)},
-          {"ci95_low", jnum(s.lo)},
-          {"ci95_high", jnum(s.hi)}};
+          {"mean", finite_or_null(s.mean)},
+          {"sd", finite_or_null(s.sd)},
+          {"ci95_low", finite_or_null(s.lo)},
+          {"ci95_high", finite_or_null(s.hi)}};
 }
 
 std::string file_safe(const std::string& s) {
@@ -412,12 +412,12 @@ Part pooled_section_errors(const Pool& pool, const std::vector<const PooledSecti
     }
     const eval::Summary sum = eval::summarize(v);
     p.json[column] = {{"n", sum.n},
-                      {"min", jnum(v.empty() ? kNaN : sum.min)},
-                      {"mean", jnum(v.empty() ? kNaN : sum.mean)},
-                      {"median", jnum(v.empty() ? kNaN : sum.median)},
-                      {"sd", jnum(v.size() < 2 ? kNaN : sum.sd_sample)},
-                      {"rmse", jnum(v.empty() ? kNaN : sum.rmse)},
-                      {"max", jnum(v.empty() ? kNaN : sum.max)}};
+                      {"min", finite_or_null(v.empty() ? kNaN : sum.min)},
+                      {"mean", finite_or_null(v.empty() ? kNaN : sum.mean)},
+                      {"median", finite_or_null(v.empty() ? kNaN : sum.median)},
+                      {"sd", finite_or_null(v.size() < 2 ? kNaN : sum.sd_sample)},
+                      {"rmse", finite_or_null(v.empty() ? kNaN : sum.rmse)},
+                      {"max", finite_or_null(v.empty() ? kNaN : sum.max)}};
     auto f = [&](double x, bool ok) { return ok ? fmt::format("{:.4g}", x) : std::string("—"); };
     p.md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", label, f(sum.min, sum.n > 0),
                         f(sum.mean, sum.n > 0), f(sum.median, sum.n > 0),

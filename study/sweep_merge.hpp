@@ -73,4 +73,7 @@ const std::vector<RunMetric>& run_metrics();
 double run_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
                         const RunMetric& metric);
 
+/// `v` as JSON, or null where it is not finite (JSON has no NaN).
+nlohmann::ordered_json finite_or_null(double v);
+
 }  // namespace driftlab::study

@@ -23,6 +23,22 @@
 #include "sim/render/shaders.hpp"
 
 namespace driftlab::sim {
+namespace render {
+
+// A mesh uploaded to the GPU, with its bounding sphere for culling.
+struct GpuMesh {
+  GLuint vao = 0, vbo = 0, ebo = 0;
+  GLsizei count = 0;
+  Material material;
+  bool on_body = false;                              // Mesh::on_body
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();  // bounding sphere, mesh frame
+  float radius = 0;
+};
+
+}  // namespace render
+
+using render::GpuMesh;
+
 namespace {
 
 constexpr float kNear = 0.05f;
@@ -35,15 +51,6 @@ void set_mat4(GLuint p, const char* name, const Eigen::Matrix4f& m) {
 }
 
 Eigen::Matrix4f to_view(const SE3& T_W_C) { return T_W_C.inverse().matrix().cast<float>(); }
-
-struct GpuMesh {
-  GLuint vao = 0, vbo = 0, ebo = 0;
-  GLsizei count = 0;
-  Material material;
-  bool on_body = false;                              // Mesh::on_body
-  Eigen::Vector3f centre = Eigen::Vector3f::Zero();  // bounding sphere, mesh frame
-  float radius = 0;
-};
 
 // Frustum planes (a x + b y + c z + d >= 0 inside) of a view-projection
 // matrix (Gribb and Hartmann's extraction).

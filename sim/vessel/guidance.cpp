@@ -12,8 +12,6 @@
 namespace driftlab::sim {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 double heading_of(const Vec2& d) { return std::atan2(d.y(), d.x()); }
 
 Vec2 dir(double heading) { return Vec2(std::cos(heading), std::sin(heading)); }
@@ -95,7 +93,7 @@ std::vector<MissionSegment> plan_mission(const MissionOptions& m, const Vec2& st
       for (int i = 1; i <= turns; ++i) {
         MissionSegment turn;
         turn.kind = MissionSegment::Kind::kTurn;
-        turn.heading_rad = wrap_angle_rad(start_heading + i * kPi / 2);
+        turn.heading_rad = wrap_angle_rad(start_heading + i * std::numbers::pi / 2);
         out.push_back(turn);
       }
       break;

@@ -36,7 +36,6 @@ namespace driftlab::sim {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr double kKm_rad_m = 370.0;  // [E97] k_m: the minimum phase speed's wavenumber
 constexpr double kCm_m_s = 0.23;     // [E97] c_m: the minimum phase speed
 constexpr double kDrag10 = 1.44e-3;  // [E97] neutral drag coefficient at 10 m, u* = sqrt(C_D) U10
@@ -102,7 +101,7 @@ double ElfouhailySpectrum::spreading(double k) const {
 double ElfouhailySpectrum::directional(double k, double phi) const {
   if (k <= 0.0) return 0.0;
   const double s = curvature(k) / (k * k * k);  // S(k) [m^3]
-  return s * (1.0 + spreading(k) * std::cos(2.0 * phi)) / (2.0 * kPi) / k;
+  return s * (1.0 + spreading(k) * std::cos(2.0 * phi)) / (2.0 * std::numbers::pi) / k;
 }
 
 double ElfouhailySpectrum::mean_square_slope(double k_lo, double k_hi) const {
@@ -139,7 +138,9 @@ struct RippleMaps::Impl {
   fftwf_plan plan = nullptr;
 
   // Wave vector of grid index i (0..N-1) on a tile of size L: FFT order.
-  static double wavenumber(int i, double L) { return 2.0 * kPi * (i < N / 2 ? i : i - N) / L; }
+  static double wavenumber(int i, double L) {
+    return 2.0 * std::numbers::pi * (i < N / 2 ? i : i - N) / L;
+  }
   void fill_tile(Tile* tile, const ElfouhailySpectrum& spectrum, double k_lo, double k_hi,
                  double wind_rad, const Vec2& current, Rng* rng) const;
   void moments(Tile* tile) const;
@@ -148,7 +149,7 @@ struct RippleMaps::Impl {
 void RippleMaps::Impl::fill_tile(Tile* tile, const ElfouhailySpectrum& spectrum, double k_lo,
                                  double k_hi, double wind_rad, const Vec2& current,
                                  Rng* rng) const {
-  const double L = tile->size_m, dk = 2.0 * kPi / L;
+  const double L = tile->size_m, dk = 2.0 * std::numbers::pi / L;
   const Vec2 w(std::cos(wind_rad), std::sin(wind_rad));
   tile->h0.assign(static_cast<std::size_t>(N) * N, {0.0, 0.0});
   tile->omega.assign(static_cast<std::size_t>(N) * N, 0.0);
@@ -219,11 +220,11 @@ RippleMaps::RippleMaps(const WindOptions& wind, const CurrentOptions& current, R
   const double golden = (1.0 + std::sqrt(5.0)) / 2.0;
   m.tiles[0].size_m = 4.0;
   m.tiles[1].size_m = 4.0 / (golden * golden * golden);
-  const double k_split = 2.0 * kPi / kSplitWavelength_m;
-  const double k_short = 2.0 * kPi / kShortestWavelength_m;
-  const double cd = current.direction_deg * kPi / 180.0;
+  const double k_split = 2.0 * std::numbers::pi / kSplitWavelength_m;
+  const double k_short = 2.0 * std::numbers::pi / kShortestWavelength_m;
+  const double cd = current.direction_deg * std::numbers::pi / 180.0;
   const Vec2 U = current.speed_mps * Vec2(std::cos(cd), std::sin(cd));
-  const double wind_rad = wind.direction_deg * kPi / 180.0;
+  const double wind_rad = wind.direction_deg * std::numbers::pi / 180.0;
   m.fill_tile(&m.tiles[0], spectrum, 0.0, k_split, wind_rad, U, &rng);
   m.fill_tile(&m.tiles[1], spectrum, k_split, k_short, wind_rad, U, &rng);
   // The expected slope variance the tiles hold.

@@ -37,7 +37,6 @@ namespace driftlab::sim {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 // JONSWAP discretisation range, as multiples of the peak frequency. Below 0.5
@@ -50,7 +49,7 @@ constexpr double kJonswapHighCut = 4.0;
 // depth terms can skip their expm1 there and give the same bytes.
 constexpr double kNegligibleExponent = 40.0;
 
-double deg_to_rad(double deg) { return deg * (kPi / 180.0); }
+double deg_to_rad(double deg) { return deg * (std::numbers::pi / 180.0); }
 
 // ---------------------------------------------------------------------------
 // Calm water: flat and still, answers without work.
@@ -309,7 +308,7 @@ std::vector<WaveComponent> jonswap_components(const WaveOptions& o, double depth
   std::vector<double> weight(static_cast<std::size_t>(n_dir));
   double weight_sum = 0.0;
   for (int j = 0; j < n_dir; ++j) {
-    const double offset = -0.5 * kPi + (j + 0.5) * (kPi / n_dir);
+    const double offset = -0.5 * std::numbers::pi + (j + 0.5) * (std::numbers::pi / n_dir);
     dir[j] = mean_dir + offset;
     weight[j] = std::pow(std::cos(0.5 * offset), 2.0 * o.spreading_s);
     weight_sum += weight[j];

@@ -18,7 +18,7 @@ namespace driftlab::vo {
 using pnp::FeatureSet;
 using pnp::IndexMatch;
 
-namespace {
+namespace pnp {
 
 // A previous-frame 3D point and the current left pixel it was matched to.
 struct Correspondences {
@@ -30,7 +30,7 @@ struct Correspondences {
   }
 };
 
-}  // namespace
+}  // namespace pnp
 
 struct PnpStereoOdometry::Impl {
   Impl(const StereoRig& rig_in, const PnpVoOptions& options_in, Rng rng_in)
@@ -63,7 +63,7 @@ struct PnpStereoOdometry::Impl {
   FeatureSet points1, points0;
   std::vector<cv::Point3d> xyz1, xyz0;
   bool has_previous = false;
-  Correspondences corr;
+  pnp::Correspondences corr;
   std::vector<int> inliers;
   PnpFrameStats stats;
 
