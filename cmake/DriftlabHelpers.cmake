@@ -78,38 +78,69 @@ function(driftlab_module)
   add_library(driftlab::${M_NAME} ALIAS ${target})
 endfunction()
 
-# A GoogleTest executable registered with ctest; the test name is the file stem.
+# A GoogleTest file registered with ctest as test_<dir>_<stem>.
 #   driftlab_test(core/se3_test.cpp LIBS driftlab::core [LABELS slow] [COST seconds]
-#                 [DEPENDS target...])
-# Label `slow`: left out of the sanitizer run (scripts/test --sanitize, in CI), which builds
-# them only with DRIFTLAB_BUILD_SLOW_TESTS. DEPENDS: programs the test runs. COST: the file's
-# rough run time; ctest -j starts the costliest first, so that a long file does not start last
-# on a fresh checkout (ctest has no timings of its own there).
+#                 [DEPENDS target...] [DEFINES NAME=VALUE...])
+# The files of one folder (its slow ones apart) are linked into one executable, test_<dir>
+# (test_<dir>_slow), compiled in unity batches (DRIFTLAB_UNITY), so that GoogleTest's and the
+# libraries' header code is compiled once per batch; driftlab_test_executables() makes them,
+# after the last driftlab_test(). Each file is still its own ctest test, in its own process: the
+# executable with a --gtest_filter of the file's test suites. Label `slow`: left out of the
+# sanitizer run (scripts/test --sanitize, in CI), which builds them only with
+# DRIFTLAB_BUILD_SLOW_TESTS. DEPENDS: programs the test runs. COST: the file's rough run time;
+# ctest -j starts the costliest first, so that a long file does not start last on a fresh
+# checkout (ctest has no timings of its own there). With DRIFTLAB_SANITIZE the cases named in
+# DRIFTLAB_SANITIZER_SKIPS (Suite.Case) are left out.
 function(driftlab_test source)
-  cmake_parse_arguments(T "" "COST" "LIBS;LABELS;DEPENDS" ${ARGN})
+  cmake_parse_arguments(T "" "COST" "LIBS;LABELS;DEPENDS;DEFINES" ${ARGN})
   if("slow" IN_LIST T_LABELS AND NOT DRIFTLAB_BUILD_SLOW_TESTS)
     return()
   endif()
   get_filename_component(stem ${source} NAME_WE)
   get_filename_component(dir ${source} DIRECTORY)
   string(REPLACE "/" "_" prefix "${dir}")
-  set(target test_${prefix}_${stem})
-  add_executable(${target} ${source})
-  driftlab_warnings(${target})
-  target_link_libraries(${target} PRIVATE ${T_LIBS} driftlab_test_support GTest::gtest GTest::gtest_main)
-  target_compile_definitions(${target} PRIVATE
-    DRIFTLAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
-    DRIFTLAB_BINARY_DIR="${PROJECT_BINARY_DIR}")
-  set_target_properties(${target} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
-  driftlab_pch(${target} driftlab_test_support)
-  if(T_DEPENDS)
-    add_dependencies(${target} ${T_DEPENDS})
+  set(group test_${prefix})
+  if("slow" IN_LIST T_LABELS)
+    string(APPEND group _slow)
   endif()
-  # One ctest test per file: the whole binary in one process. Most files build expensive
-  # fixtures once per process (rendered sequences, scenes, runs); a process per gtest case
-  # rebuilt them for each case and took twice the suite's time. Run one case with the
-  # binary's --gtest_filter.
-  add_test(NAME ${target} COMMAND ${target})
+  set_property(GLOBAL APPEND PROPERTY DRIFTLAB_TEST_GROUPS ${group})
+  set_property(GLOBAL APPEND PROPERTY ${group}_SOURCES ${source})
+  set_property(GLOBAL APPEND PROPERTY ${group}_LIBS ${T_LIBS})
+  set_property(GLOBAL APPEND PROPERTY ${group}_DEPENDS ${T_DEPENDS})
+  set_property(GLOBAL APPEND PROPERTY ${group}_DEFINES ${T_DEFINES})
+
+  # The file's suites, from its TEST, TEST_F, TEST_P and TYPED_TEST lines (typed and
+  # instantiated suites carry a /suffix or prefix/).
+  file(STRINGS ${CMAKE_CURRENT_SOURCE_DIR}/${source} lines
+       REGEX "^(TEST|TEST_F|TEST_P|TYPED_TEST)\\( *[A-Za-z0-9_]+ *,")
+  set(suites)
+  foreach(line IN LISTS lines)
+    string(REGEX REPLACE "^[A-Z_]+\\( *([A-Za-z0-9_]+) *,.*" "\\1" suite "${line}")
+    list(APPEND suites ${suite})
+  endforeach()
+  list(REMOVE_DUPLICATES suites)
+  if(NOT suites)
+    message(FATAL_ERROR "driftlab_test(${source}): no TEST, TEST_F, TEST_P or TYPED_TEST line")
+  endif()
+  get_property(taken GLOBAL PROPERTY ${group}_SUITES)
+  set(patterns)
+  foreach(suite IN LISTS suites)
+    if(suite IN_LIST taken)
+      message(FATAL_ERROR "driftlab_test(${source}): test suite ${suite} is in another file of "
+                          "${group}; name it after this file")
+    endif()
+    list(APPEND patterns "${suite}.*" "${suite}/*" "*/${suite}.*" "*/${suite}/*")
+  endforeach()
+  set_property(GLOBAL APPEND PROPERTY ${group}_SUITES ${suites})
+  set_property(GLOBAL APPEND PROPERTY ${group}_PATTERNS ${patterns})
+  list(JOIN patterns ":" filter)
+  if(DRIFTLAB_SANITIZE AND DRIFTLAB_SANITIZER_SKIPS)
+    list(JOIN DRIFTLAB_SANITIZER_SKIPS ":" skips)
+    string(APPEND filter "-${skips}")
+  endif()
+
+  set(name test_${prefix}_${stem})
+  add_test(NAME ${name} COMMAND ${group} --gtest_filter=${filter})
   set(props WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   if(T_LABELS)
     list(APPEND props LABELS ${T_LABELS})
@@ -120,5 +151,36 @@ function(driftlab_test source)
   if(DRIFTLAB_SANITIZER_ENV)
     list(APPEND props ENVIRONMENT ${DRIFTLAB_SANITIZER_ENV})
   endif()
-  set_tests_properties(${target} PROPERTIES ${props})
+  set_tests_properties(${name} PROPERTIES ${props})
+endfunction()
+
+# The executables of the files given to driftlab_test(), one per folder (and its slow files).
+function(driftlab_test_executables)
+  get_property(groups GLOBAL PROPERTY DRIFTLAB_TEST_GROUPS)
+  list(REMOVE_DUPLICATES groups)
+  foreach(group IN LISTS groups)
+    foreach(what SOURCES LIBS DEPENDS DEFINES)
+      get_property(${what} GLOBAL PROPERTY ${group}_${what})
+      list(REMOVE_DUPLICATES ${what})
+    endforeach()
+    add_executable(${group} ${SOURCES})
+    driftlab_warnings(${group})
+    target_link_libraries(${group} PRIVATE ${LIBS} driftlab_test_support GTest::gtest
+                                           GTest::gtest_main)
+    target_compile_definitions(${group} PRIVATE DRIFTLAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+                                                DRIFTLAB_BINARY_DIR="${PROJECT_BINARY_DIR}" ${DEFINES})
+    set_target_properties(${group} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
+    driftlab_pch(${group} driftlab_test_support)
+    if(DEPENDS)
+      add_dependencies(${group} ${DEPENDS})
+    endif()
+    # Every case of the executable is some file's: listing the cases that no file's filter
+    # selects must list none (a case that only the executable knows would never run).
+    get_property(patterns GLOBAL PROPERTY ${group}_PATTERNS)
+    list(JOIN patterns ":" all)
+    add_test(NAME ${group}_every_case_has_its_file
+             COMMAND ${group} --gtest_list_tests "--gtest_filter=-${all}")
+    set_tests_properties(${group}_every_case_has_its_file PROPERTIES
+                         FAIL_REGULAR_EXPRESSION "(^|\n)[A-Za-z0-9_/]+\\.(\n|  #)")
+  endforeach()
 endfunction()

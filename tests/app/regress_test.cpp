@@ -21,7 +21,7 @@ using driftlab::test::run_cli;
 using driftlab::test::shell_quote;
 using driftlab::test::slurp;
 
-const fs::path kCli = fs::path(DRIFTLAB_BINARY_DIR) / "bin" / "driftlab";
+const fs::path kRegressCli = fs::path(DRIFTLAB_BINARY_DIR) / "bin" / "driftlab";
 
 class Regress : public ::testing::Test {
  protected:
@@ -249,7 +249,7 @@ TEST_F(Regress, StandaloneGateBinaryMatchesRegressAndLinksNoRendererCeresOrAssim
   for (const char* lib : {"OSMesa", "libEGL", "libceres", "libassimp", "libopencv"})
     EXPECT_EQ(ldd.out.find(lib), std::string::npos) << lib << " in\n" << ldd.out;
   // The full CLI does link them: the check above can fail.
-  const Result full = driftlab::test::run_shell("ldd " + shell_quote(kCli.string()));
+  const Result full = driftlab::test::run_shell("ldd " + shell_quote(kRegressCli.string()));
   EXPECT_NE(full.out.find("OSMesa"), std::string::npos) << full.out;
 }
 

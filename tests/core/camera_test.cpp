@@ -7,11 +7,12 @@
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab {
 namespace {
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
+using driftlab::test::kEps;
 // Pixel and metre quantities of order 1e2-1e3 after a handful of operations.
 constexpr double kPxTol = 1e-10;
 constexpr double kMetreTol = 1e-10;

@@ -8,18 +8,19 @@
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab {
 namespace {
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
+using driftlab::test::kEps;
 constexpr double kTightTol = 64 * kEps;
 // Angles recovered from a rotation: the extraction loses a few ulps through sin/cos/atan2, and
 // next to gimbal lock roll and yaw are individually ill-conditioned by ~1/cos(pitch).
 constexpr double kAngleTol = 1e-9;
 // Rotations (not angles) must come back to rounding error everywhere, gimbal lock included.
 constexpr double kRotationTol = 1e-12;
-constexpr double kPi = std::numbers::pi;
+using driftlab::test::kPi;
 
 // Elementary rotations written out by hand (Fossen 2.18 factors), independent of Eigen::AngleAxis.
 Mat3 Rx(double a) {

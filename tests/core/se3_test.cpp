@@ -8,19 +8,20 @@
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab {
 namespace {
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
+using driftlab::test::kEps;
 // Exact-arithmetic identities evaluated once or twice in double.
-constexpr double kTightTol = 64 * kEps;
+constexpr double kSe3TightTol = 64 * kEps;
 // Round trips through exp/log, which lose a few digits near |phi| = pi.
 constexpr double kRoundTripTol = 1e-9;
 // Central finite differences with step kFdStep: truncation ~h^2, rounding ~eps/h.
 constexpr double kFdStep = 1e-5;
 constexpr double kFdTol = 1e-8;
-constexpr double kPi = std::numbers::pi;
+using driftlab::test::kPi;
 
 Vec3 random_unit(std::mt19937& gen) {
   std::normal_distribution<double> n(0.0, 1.0);
@@ -49,7 +50,7 @@ Mat3 rot_z(double a) {
 TEST(So3Test, HatIsCrossProductAndVeeInvertsIt) {
   const Vec3 a(0.3, -1.2, 2.5);
   const Vec3 b(-0.7, 0.4, 1.1);
-  EXPECT_TRUE((hat(a) * b).isApprox(a.cross(b), kTightTol));
+  EXPECT_TRUE((hat(a) * b).isApprox(a.cross(b), kSe3TightTol));
   EXPECT_TRUE((hat(a) + hat(a).transpose()).isZero(0.0));
   EXPECT_EQ(vee(hat(a)), a);
 }
@@ -60,8 +61,8 @@ TEST(So3Test, ExpOfQuarterTurnAboutZMatchesHandWrittenMatrix) {
       1, 0, 0,           //
       0, 0, 1;
   const Quat q = so3_exp(Vec3(0, 0, kPi / 2));
-  EXPECT_TRUE(q.toRotationMatrix().isApprox(expected, kTightTol)) << q.toRotationMatrix();
-  EXPECT_NEAR(q.norm(), 1.0, kTightTol);
+  EXPECT_TRUE(q.toRotationMatrix().isApprox(expected, kSe3TightTol)) << q.toRotationMatrix();
+  EXPECT_NEAR(q.norm(), 1.0, kSe3TightTol);
 }
 
 TEST(So3Test, ExpLogRoundTripRandom) {
@@ -80,7 +81,7 @@ TEST(So3Test, LogOfRandomQuaternionIsWithinPiAndExpsBack) {
   for (int i = 0; i < 2000; ++i) {
     const Quat q(n(gen), n(gen), n(gen), n(gen));  // any sign of w, not unit length
     const Vec3 phi = so3_log(q);
-    EXPECT_LE(phi.norm(), kPi + kTightTol);
+    EXPECT_LE(phi.norm(), kPi + kSe3TightTol);
     EXPECT_LT(angle_between(so3_exp(phi), q.normalized()), kRoundTripTol);
   }
 }
@@ -91,11 +92,11 @@ TEST(So3Test, SmallAngleExpAndLogAreFiniteAndAccurate) {
     const Quat q = so3_exp(phi);
     ASSERT_TRUE(q.coeffs().allFinite()) << angle;
     // To first order q = [1, phi/2]; the next term is O(angle^2) relative.
-    EXPECT_NEAR(q.w(), 1.0, angle * angle + kTightTol);
-    EXPECT_TRUE((2.0 * q.vec()).isApprox(phi, angle * angle + kTightTol) || angle == 0.0);
+    EXPECT_NEAR(q.w(), 1.0, angle * angle + kSe3TightTol);
+    EXPECT_TRUE((2.0 * q.vec()).isApprox(phi, angle * angle + kSe3TightTol) || angle == 0.0);
     const Vec3 back = so3_log(q);
     ASSERT_TRUE(back.allFinite()) << angle;
-    EXPECT_LE((back - phi).norm(), kTightTol * std::max(angle, 1e-300)) << angle;
+    EXPECT_LE((back - phi).norm(), kSe3TightTol * std::max(angle, 1e-300)) << angle;
   }
 }
 
@@ -104,7 +105,7 @@ TEST(So3Test, LogNearPi) {
   for (double angle : {kPi - 1e-3, kPi - 1e-9, kPi}) {
     const Vec3 phi = angle * axis;
     const Vec3 back = so3_log(so3_exp(phi));
-    EXPECT_LE(back.norm(), kPi + kTightTol);
+    EXPECT_LE(back.norm(), kPi + kSe3TightTol);
     // At exactly pi, +axis and -axis are the same rotation.
     EXPECT_TRUE(back.isApprox(phi, kRoundTripTol) || back.isApprox(-phi, kRoundTripTol))
         << angle << ": " << back.transpose();
@@ -195,7 +196,7 @@ TEST(Se3Test, ExpOfPureRotationAboutZMatchesHandWrittenMatrix) {
       1, 0, 0, 0,           //
       0, 0, 1, 0,           //
       0, 0, 0, 1;
-  EXPECT_TRUE(SE3::exp(xi).matrix().isApprox(expected, kTightTol)) << SE3::exp(xi).matrix();
+  EXPECT_TRUE(SE3::exp(xi).matrix().isApprox(expected, kSe3TightTol)) << SE3::exp(xi).matrix();
 }
 
 TEST(Se3Test, ExpOfPureTranslationIsThatTranslation) {
@@ -213,7 +214,7 @@ TEST(Se3Test, SmallTwistLogExpIsFiniteAndAccurate) {
   ASSERT_TRUE(T.matrix().allFinite());
   const Vec6 back = T.log();
   ASSERT_TRUE(back.allFinite());
-  EXPECT_LT((back - xi).norm(), kTightTol * 1e-12);
+  EXPECT_LT((back - xi).norm(), kSe3TightTol * 1e-12);
   EXPECT_EQ(SE3().log(), Vec6::Zero());
 }
 
@@ -248,10 +249,10 @@ TEST(Se3Test, CompositionMatchesHandComputedMatrixProduct) {
   ASSERT_TRUE((A * B).isApprox(AB));  // the hand computation itself
   const SE3 a(A);
   const SE3 b(B);
-  EXPECT_TRUE((a * b).matrix().isApprox(AB, kTightTol)) << (a * b).matrix();
+  EXPECT_TRUE((a * b).matrix().isApprox(AB, kSe3TightTol)) << (a * b).matrix();
   const Vec3 p(0.3, -0.7, 1.9);
-  EXPECT_TRUE(((a * b) * p).isApprox(a * (b * p), kTightTol));
-  EXPECT_TRUE((a * p).isApprox((A * p.homogeneous()).head<3>(), kTightTol));
+  EXPECT_TRUE(((a * b) * p).isApprox(a * (b * p), kSe3TightTol));
+  EXPECT_TRUE((a * p).isApprox((A * p.homogeneous()).head<3>(), kSe3TightTol));
 }
 
 TEST(Se3Test, InverseMatchesHandComputedAndComposesToIdentity) {
@@ -267,7 +268,7 @@ TEST(Se3Test, InverseMatchesHandComputedAndComposesToIdentity) {
       0, 0, 1, 0,       //
       0, 0, 0, 1;
   const SE3 a(A);
-  EXPECT_TRUE(a.inverse().matrix().isApprox(A_inv, kTightTol)) << a.inverse().matrix();
+  EXPECT_TRUE(a.inverse().matrix().isApprox(A_inv, kSe3TightTol)) << a.inverse().matrix();
 
   std::mt19937 gen(5);
   for (int i = 0; i < 100; ++i) {
@@ -320,7 +321,7 @@ TEST(Se3Test, RejectsNonOrthonormalRotation) {
   Mat3 nearly = rot_z(0.3);
   nearly(0, 0) += 1e-9;  // well inside the tolerance: accepted and re-orthonormalised
   const SE3 T(nearly, Vec3::Zero());
-  EXPECT_NEAR(T.quaternion().norm(), 1.0, kTightTol);
+  EXPECT_NEAR(T.quaternion().norm(), 1.0, kSe3TightTol);
 
   Mat4 bad_bottom = Mat4::Identity();
   bad_bottom(3, 0) = 1.0;
@@ -336,13 +337,13 @@ TEST(Se3Test, QuaternionIsNormalisedAndZeroRejected) {
   const SE3 step = SE3::exp((Vec6() << 0.1, 0.0, 0.0, 0.01, 0.02, -0.03).finished());
   SE3 chain;
   for (int i = 0; i < 100000; ++i) chain = chain * step;
-  EXPECT_NEAR(chain.quaternion().norm(), 1.0, kTightTol);
+  EXPECT_NEAR(chain.quaternion().norm(), 1.0, kSe3TightTol);
 }
 
 TEST(Se3Test, IsApproxAndAngleBetweenIgnoreQuaternionSign) {
   const Quat q = so3_exp(Vec3(0.4, -0.2, 1.0));
   const Quat minus_q(-q.w(), -q.x(), -q.y(), -q.z());
-  EXPECT_LT(angle_between(q, minus_q), kTightTol);
+  EXPECT_LT(angle_between(q, minus_q), kSe3TightTol);
   EXPECT_TRUE(SE3(q, Vec3(1, 2, 3)).is_approx(SE3(minus_q, Vec3(1, 2, 3))));
   EXPECT_NEAR(angle_between(Quat::Identity(), so3_exp(Vec3(0, 1e-10, 0))), 1e-10, 1e-20);
   EXPECT_NEAR(angle_between(Quat::Identity(), so3_exp(Vec3(0, 0, 3.0))), 3.0, 1e-12);

@@ -20,12 +20,13 @@
 
 #include "core/error.hpp"
 #include "core/rng.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab {
 namespace {
 namespace fs = std::filesystem;
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
+using driftlab::test::kEps;
 
 bool same_bits(double a, double b) {
   return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);

@@ -219,26 +219,24 @@ TEST(TumRgbdExport, DepthIsSixteenBitAtFiveThousandPerMetre) {
   fs::remove_all(root);
 }
 
-const auto error_of = driftlab::test::user_error_of;
-
 TEST(DatasetReaders, NameTheFileLineAndExpectation) {
   const fs::path root = test::fresh_temp_dir("dataset_errors");
   Sequence{}.write(*make_writer(DatasetFormat::kKitti, root, calibration()));
   const fs::path calib = root / "sequences" / "00" / "calib.txt";
   std::ofstream(calib) << "P0: 1 2 3\nP1: 1 0 0 0 0 1 0 0 0 0 1 0\n";
-  std::string e = error_of([&] { read_dataset(root, DatasetFormat::kKitti); });
+  std::string e = driftlab::test::user_error_of([&] { read_dataset(root, DatasetFormat::kKitti); });
   EXPECT_NE(e.find(calib.string() + ":1: P0: got 3 numbers, expected 12"), std::string::npos) << e;
   std::ofstream(calib) << "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nP1: 1 0 0 0 0 1 0 0 0 0 1 0\n";
-  e = error_of([&] { read_dataset(root, DatasetFormat::kKitti); });
+  e = driftlab::test::user_error_of([&] { read_dataset(root, DatasetFormat::kKitti); });
   EXPECT_NE(e.find("not a rectified pair"), std::string::npos) << e;
-  e = error_of([&] {
+  e = driftlab::test::user_error_of([&] {
     read_dataset(root, DatasetFormat::kKitti,
                  {.sequence = "07", .gt_topic = {}, .calibration = {}});
   });
   EXPECT_NE(e.find("expected sequences/07/"), std::string::npos) << e;
-  e = error_of([&] { read_dataset(root / "nowhere", DatasetFormat::kEuroc); });
+  e = driftlab::test::user_error_of([&] { read_dataset(root / "nowhere", DatasetFormat::kEuroc); });
   EXPECT_NE(e.find("no such dataset folder"), std::string::npos) << e;
-  e = error_of([] { format_from_name("mcap"); });
+  e = driftlab::test::user_error_of([] { format_from_name("mcap"); });
   EXPECT_NE(e.find("got 'mcap', expected one of: kitti, euroc, tum-rgbd, rosbag, rosbag2"),
             std::string::npos);
 
@@ -251,7 +249,7 @@ TEST(DatasetReaders, NameTheFileLineAndExpectation) {
   std::string yaml = good_yaml;
   yaml.replace(yaml.find("radial-tangential"), 17, "omni");
   std::ofstream(cam1) << yaml;
-  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  e = driftlab::test::user_error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
   EXPECT_NE(e.find("distortion_model: got 'omni' with 4 coefficients, expected "
                    "radial-tangential"),
             std::string::npos)
@@ -259,14 +257,14 @@ TEST(DatasetReaders, NameTheFileLineAndExpectation) {
   yaml = good_yaml;
   yaml.replace(yaml.find("radial-tangential"), 17, "equidistant");
   std::ofstream(cam1) << yaml;
-  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  e = driftlab::test::user_error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
   EXPECT_NE(e.find("distortion_model: got 'equidistant' and cam0's 'radial-tangential', expected "
                    "one model for both cameras"),
             std::string::npos)
       << e;
   // What the fuzzer found (fuzz/regressions/dataset): each a UserError naming the file.
   std::ofstream(cam1) << "just a scalar\n";
-  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  e = driftlab::test::user_error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
   EXPECT_NE(e.find(cam1.string() + ": expected a mapping of keys (intrinsics, resolution, T_BS)"),
             std::string::npos)
       << e;
@@ -274,17 +272,17 @@ TEST(DatasetReaders, NameTheFileLineAndExpectation) {
   const std::size_t res = yaml.find("resolution: [");
   yaml.replace(res, yaml.find(']', res) - res, "resolution: [1e20, 60");
   std::ofstream(cam1) << yaml;
-  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  e = driftlab::test::user_error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
   EXPECT_NE(e.find("resolution: got 1e+20 x "), std::string::npos) << e;
   EXPECT_NE(e.find("expected whole numbers of pixels in [1, 16384]"), std::string::npos) << e;
   yaml = good_yaml;
   const std::size_t fu = yaml.find("intrinsics: [");
   yaml.replace(fu, yaml.find(',', fu) - fu, "intrinsics: [.nan");
   std::ofstream(cam1) << yaml;
-  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  e = driftlab::test::user_error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
   EXPECT_NE(e.find("intrinsics: got '.nan', expected a finite number"), std::string::npos) << e;
   std::ofstream(cam1) << slurp(eu / "mav0" / "cam0" / "sensor.yaml");  // cam1 where cam0 is
-  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  e = driftlab::test::user_error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
   EXPECT_NE(e.find("T_BS: cam1 sits where cam0 does, expected a stereo pair with a baseline"),
             std::string::npos)
       << e;
@@ -296,13 +294,13 @@ TEST(DatasetReaders, NameTheFileLineAndExpectation) {
   std::ofstream(eu / "mav0" / "imu0" / "sensor.yaml") << "rate_hz: 200\n"
                                                          "gyroscope_noise_density: 1e-4\n"
                                                          "gyroscope_random_walk: -1\n";
-  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  e = driftlab::test::user_error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
   EXPECT_NE(e.find("sensor.yaml:3: gyroscope_random_walk: got '-1', expected a number > 0"),
             std::string::npos)
       << e;
   fs::remove_all(eu / "mav0" / "imu0");
   std::ofstream(eu / "mav0" / "cam0" / "data.csv") << "#timestamp [ns],filename\n12x,a.png\n";
-  e = error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
+  e = driftlab::test::user_error_of([&] { read_dataset(eu, DatasetFormat::kEuroc); });
   EXPECT_NE(e.find("data.csv:2: timestamp: got '12x'"), std::string::npos) << e;
   fs::remove_all(root);
   fs::remove_all(eu);
@@ -319,17 +317,17 @@ TEST(CompassCsv, ReadsHeadingsInDegreesAndNamesTheLineOfABadOne) {
   EXPECT_NEAR(r[0].heading_rad, std::numbers::pi / 2, 1e-15);
   EXPECT_NEAR(r[1].heading_rad, -std::numbers::pi / 2, 1e-15);  // wrapped to (-pi, pi]
   std::ofstream(csv) << "100,90,1,2,3\n200,360,1,2,3\n";
-  std::string e = error_of([&] { read_compass_csv(csv); });
+  std::string e = driftlab::test::user_error_of([&] { read_compass_csv(csv); });
   EXPECT_NE(e.find(csv.string() + ":2: heading: got 360, expected degrees in [0, 360)"),
             std::string::npos)
       << e;
   std::ofstream(csv) << "100,90,1,2,3\n100,91,1,2,3\n";
-  e = error_of([&] { read_compass_csv(csv); });
+  e = driftlab::test::user_error_of([&] { read_compass_csv(csv); });
   EXPECT_NE(e.find(":2: timestamp: got 100, expected more than the line before's 100"),
             std::string::npos)
       << e;
   std::ofstream(csv) << "100,90\n";
-  e = error_of([&] { read_compass_csv(csv); });
+  e = driftlab::test::user_error_of([&] { read_compass_csv(csv); });
   EXPECT_NE(e.find(":1: got 2 columns, expected 5"), std::string::npos) << e;
   fs::remove_all(dir);
 }

@@ -41,7 +41,7 @@ std::string python(const std::string& script, const std::vector<std::string>& ar
   return slurp(output);
 }
 
-ExportCalibration calibration() {
+ExportCalibration bag_calibration() {
   ExportCalibration cal;
   cal.rig.camera = {480, 470, 40.5, 30.25, 80, 60};
   cal.rig.baseline_m = 0.25;
@@ -57,12 +57,12 @@ ExportCalibration calibration() {
 }
 
 // Three frames (the first stamped 0), IMU, GPS (a fix and none), compass and the IMU's truth.
-struct Sequence {
+struct BagSequence {
   std::vector<TimeNs> stamps{0, 100'000'123, 200'000'000};
   std::vector<cv::Mat> left, right;
   std::vector<ImuSample> imu;
   ExportTruth truth;
-  explicit Sequence(const fs::path& staging) {
+  explicit BagSequence(const fs::path& staging) {
     cv::RNG rng(7);
     for (std::size_t i = 0; i < stamps.size(); ++i) {
       cv::Mat l(60, 80, CV_8UC1), r(60, 80, CV_8UC1);
@@ -111,7 +111,7 @@ Quat quat_of(const json& q) { return Quat(q[0], q[1], q[2], q[3]); }
 
 // An export's bag as an independent reader decoded it (read_bag.py's JSON) against the
 // sequence written: ROS 1 (`ros2` false) or ROS 2 (types with /msg/, no seq, no record time).
-void expect_the_sequence(const json& bag, const Sequence& seq, bool ros2) {
+void expect_the_sequence(const json& bag, const BagSequence& seq, bool ros2) {
   const auto type = [&](std::string t) { return ros2 ? t.insert(t.find('/'), "/msg") : t; };
   const std::map<std::string, std::pair<std::string, int>> expected_topics = {
       {"/cam0/image_raw", {"sensor_msgs/Image", 3}},
@@ -213,25 +213,25 @@ void expect_the_sequence(const json& bag, const Sequence& seq, bool ros2) {
   EXPECT_EQ(tf[1]["t"].get<std::vector<double>>(), (std::vector<double>{0, -0.5, 3}));
   EXPECT_EQ(tf[4]["parent"], "imu");
   EXPECT_EQ(tf[4]["child"], "cam1_optical");
-  const Vec3 cam1 = calibration().T_S_C * Vec3(0.25, 0, 0);
+  const Vec3 cam1 = bag_calibration().T_S_C * Vec3(0.25, 0, 0);
   for (int a = 0; a < 3; ++a) EXPECT_NEAR(tf[4]["t"][a].get<double>(), cam1[a], 1e-15);
 }
 
 TEST(RosbagExport, PythonsRosbagReadsEveryMessageWithItsStampsAndValues) {
   const fs::path root = test::fresh_temp_dir("rosbag_export");
-  const Sequence seq(root / "staging");
-  seq.write(*make_writer(DatasetFormat::kRosbag, root, calibration()));
+  const BagSequence seq(root / "staging");
+  seq.write(*make_writer(DatasetFormat::kRosbag, root, bag_calibration()));
   const json bag = json::parse(
       python("read_bag.py", {(root / rosbag_names::kBagFile).string()}, root / "bag.json"));
   EXPECT_EQ(bag["version"], 200);
   expect_the_sequence(bag, seq, false);
-  // The calibration files: OpenCV's FileStorage reads VINS-Fusion's configuration.
+  // The bag_calibration files: OpenCV's FileStorage reads VINS-Fusion's configuration.
   cv::FileStorage vins((root / "vins_fusion" / "stereo_imu_config.yaml").string(),
                        cv::FileStorage::READ);
   cv::Mat body_T_cam1;
   vins["body_T_cam1"] >> body_T_cam1;
   ASSERT_EQ(body_T_cam1.rows, 4);
-  const Vec3 cam1 = calibration().T_S_C * Vec3(0.25, 0, 0);
+  const Vec3 cam1 = bag_calibration().T_S_C * Vec3(0.25, 0, 0);
   for (int a = 0; a < 3; ++a) EXPECT_NEAR(body_T_cam1.at<double>(a, 3), cam1[a], 1e-15);
   EXPECT_EQ(static_cast<std::string>(vins["image1_topic"]), "/cam1/image_raw");
   EXPECT_DOUBLE_EQ(static_cast<double>(vins["gyr_n"]), 1.7e-4);
@@ -240,8 +240,8 @@ TEST(RosbagExport, PythonsRosbagReadsEveryMessageWithItsStampsAndValues) {
 
 TEST(Rosbag2Export, ADecoderOfItsOwnFindsEveryMessageInTheDatabase) {
   const fs::path root = test::fresh_temp_dir("rosbag2_export");
-  const Sequence seq(root / "staging");
-  seq.write(*make_writer(DatasetFormat::kRosbag2, root, calibration()));
+  const BagSequence seq(root / "staging");
+  seq.write(*make_writer(DatasetFormat::kRosbag2, root, bag_calibration()));
   const json bag = json::parse(
       python("read_rosbag2.py", {(root / rosbag_names::kBag2Folder).string()}, root / "bag.json"));
   EXPECT_EQ(bag["version"], 5);
@@ -257,8 +257,8 @@ TEST(Rosbag2Export, ADecoderOfItsOwnFindsEveryMessageInTheDatabase) {
 
 TEST(RosbagExport, ReadsBackThroughItsKalibrChain) {
   const fs::path root = test::fresh_temp_dir("rosbag_reader");
-  const Sequence seq(root / "staging");
-  seq.write(*make_writer(DatasetFormat::kRosbag, root, calibration()));
+  const BagSequence seq(root / "staging");
+  seq.write(*make_writer(DatasetFormat::kRosbag, root, bag_calibration()));
   const StereoDataset d = read_dataset(root, DatasetFormat::kRosbag);
   EXPECT_EQ(d.format, DatasetFormat::kRosbag);
   EXPECT_EQ(d.rig.camera.fx, 480);
@@ -266,7 +266,7 @@ TEST(RosbagExport, ReadsBackThroughItsKalibrChain) {
   EXPECT_NEAR(d.rig.baseline_m, 0.25, 1e-15);
   EXPECT_FALSE(d.rectification);
   EXPECT_TRUE(d.has_extrinsics);
-  EXPECT_LT((d.T_S_C.inverse() * calibration().T_S_C).log().norm(), 1e-12);
+  EXPECT_LT((d.T_S_C.inverse() * bag_calibration().T_S_C).log().norm(), 1e-12);
   ASSERT_EQ(d.frames.size(), 3u);
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_EQ(d.frames[i].t_ns, seq.stamps[i]);
@@ -283,7 +283,7 @@ TEST(RosbagExport, ReadsBackThroughItsKalibrChain) {
   EXPECT_NEAR(d.compass[1].heading_rad, deg2rad(350.5 - 360), 1e-12);
   EXPECT_NEAR(d.compass[0].field_S_nt.x(), 17000, 1e-9);
   ASSERT_EQ(d.camera_gt.size(), seq.truth.body.size());
-  const SE3 expected = seq.truth.body[5].T_W_S * calibration().T_S_C;
+  const SE3 expected = seq.truth.body[5].T_W_S * bag_calibration().T_S_C;
   EXPECT_LT((d.camera_gt[5].T_W_C.inverse() * expected).log().norm(), 1e-12);
   fs::remove_all(root);
 }
@@ -354,7 +354,7 @@ TEST(RosbagRead, AnEurocLayoutBagFromRosPythonGivesWhatItsEurocFolderGives) {
   EXPECT_FALSE(bag.imu_noise.has_value());  // no Kalibr IMU chain beside the camera chain
   // Position-only truth is a clear error naming the topic and why.
   options.gt_topic = "/leica/position";
-  const std::string leica = test::user_error_of(
+  const std::string leica = driftlab::test::user_error_of(
       [&] { read_dataset(root / "euroc_like.bag", DatasetFormat::kRosbag, options); });
   EXPECT_NE(leica.find("/leica/position: got ground truth of type geometry_msgs/PointStamped"),
             std::string::npos)
@@ -364,13 +364,13 @@ TEST(RosbagRead, AnEurocLayoutBagFromRosPythonGivesWhatItsEurocFolderGives) {
 
 TEST(RosbagRead, BadInputIsAClearError) {
   const fs::path root = test::fresh_temp_dir("rosbag_errors");
-  const Sequence seq(root / "export" / "staging");
-  seq.write(*make_writer(DatasetFormat::kRosbag, root / "export", calibration()));
+  const BagSequence seq(root / "export" / "staging");
+  seq.write(*make_writer(DatasetFormat::kRosbag, root / "export", bag_calibration()));
   const fs::path bag = root / "export" / rosbag_names::kBagFile;
   const auto read = [&](const fs::path& path, const ReadOptions& o) {
-    return test::user_error_of([&] { read_dataset(path, DatasetFormat::kRosbag, o); });
+    return driftlab::test::user_error_of([&] { read_dataset(path, DatasetFormat::kRosbag, o); });
   };
-  // No calibration beside the bag.
+  // No bag_calibration beside the bag.
   fs::create_directories(root / "alone");
   fs::copy_file(bag, root / "alone" / "x.bag");
   EXPECT_NE(read(root / "alone" / "x.bag", {})

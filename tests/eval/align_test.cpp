@@ -50,13 +50,6 @@ void expect_transform(const SimilarityTransform& T, double s, const Mat3& R, con
   EXPECT_NEAR(T.R.determinant(), 1.0, tol);
 }
 
-const auto error_of = driftlab::test::user_error_of;
-
-void expect_error(const std::function<void()>& f, const std::string& part) {
-  const std::string msg = error_of(f);
-  EXPECT_NE(msg.find(part), std::string::npos) << "message: " << msg << "\nexpected part: " << part;
-}
-
 class AlignExactTest : public ::testing::Test {
  protected:
   std::mt19937 gen{20240611};
@@ -235,20 +228,22 @@ TEST(AlignTest, FirstNUsesOnlyTheFirstPairs) {
 
 TEST(AlignTest, BadInputsAreUserErrors) {
   const std::vector<Vec3> two{{0, 0, 0}, {1, 0, 0}};
-  expect_error([&] { align_horn(two, two); },
-               "Horn alignment needs at least 3 associated poses, got 2");
-  expect_error([&] { align_umeyama(two, two, false); },
-               "SE3 (Umeyama) alignment needs at least 3 associated poses, got 2");
-  expect_error([&] { align_umeyama(two, two, true); },
-               "Sim3 (Umeyama) alignment needs at least 3 associated poses, got 2");
-  expect_error(
+  driftlab::test::expect_user_error([&] { align_horn(two, two); },
+                                    "Horn alignment needs at least 3 associated poses, got 2");
+  driftlab::test::expect_user_error(
+      [&] { align_umeyama(two, two, false); },
+      "SE3 (Umeyama) alignment needs at least 3 associated poses, got 2");
+  driftlab::test::expect_user_error(
+      [&] { align_umeyama(two, two, true); },
+      "Sim3 (Umeyama) alignment needs at least 3 associated poses, got 2");
+  driftlab::test::expect_user_error(
       [&] {
         align_pos_yaw({{0, 0, 0}}, {{0, 0, 0}});
       },
       "Position+yaw alignment needs at least 2 associated poses, got 1");
-  expect_error([&] { compute_alignment(Alignment::kHorn, two, two, -1); },
-               "align_first_n must be >= 0, got -1");
-  expect_error(
+  driftlab::test::expect_user_error([&] { compute_alignment(Alignment::kHorn, two, two, -1); },
+                                    "align_first_n must be >= 0, got -1");
+  driftlab::test::expect_user_error(
       [&] {
         compute_alignment(Alignment::kSe3, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 1}},
                           {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 1}}, 2);
@@ -257,17 +252,21 @@ TEST(AlignTest, BadInputsAreUserErrors) {
 
   const std::vector<Vec3> spread{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   const std::vector<Vec3> same(4, Vec3(1e5 + 0.1, -3e4, 7.0));
-  expect_error([&] { align_horn(same, spread); },
-               "Horn alignment is undetermined: all 4 estimate positions coincide");
-  expect_error([&] { align_umeyama(spread, same, true); }, "all 4 ground-truth positions coincide");
+  driftlab::test::expect_user_error(
+      [&] { align_horn(same, spread); },
+      "Horn alignment is undetermined: all 4 estimate positions coincide");
+  driftlab::test::expect_user_error([&] { align_umeyama(spread, same, true); },
+                                    "all 4 ground-truth positions coincide");
   const std::vector<Vec3> vertical{{2, 3, 0}, {2, 3, 1}, {2, 3, 5}, {2, 3, -4}};
-  expect_error([&] { align_pos_yaw(vertical, spread); },
-               "all 4 estimate positions coincide in the horizontal plane");
+  driftlab::test::expect_user_error([&] { align_pos_yaw(vertical, spread); },
+                                    "all 4 estimate positions coincide in the horizontal plane");
 
   std::vector<Vec3> bad = spread;
   bad[2].y() = std::numeric_limits<double>::quiet_NaN();
-  expect_error([&] { align_horn(bad, spread); }, "estimate position 2 is not finite");
-  expect_error([&] { align_pos_yaw(spread, bad); }, "ground-truth position 2 is not finite");
+  driftlab::test::expect_user_error([&] { align_horn(bad, spread); },
+                                    "estimate position 2 is not finite");
+  driftlab::test::expect_user_error([&] { align_pos_yaw(spread, bad); },
+                                    "ground-truth position 2 is not finite");
 }
 
 TEST(AlignTest, CollinearPointsStillAlignPositions) {

@@ -62,13 +62,6 @@ std::vector<Vec3> translations(const std::vector<SE3>& poses) {
   return p;
 }
 
-const auto error_of = driftlab::test::user_error_of;
-
-void expect_error(const std::function<void()>& f, const std::string& part) {
-  const std::string msg = error_of(f);
-  EXPECT_NE(msg.find(part), std::string::npos) << "message: " << msg << "\nexpected part: " << part;
-}
-
 TEST(ApeTest, ConstantOffsetWithoutAlignmentIsThatOffsetExactly) {
   const std::vector<SE3> gt = dyadic_trajectory(50);
   const Vec3 offset(3.0, 4.0, 12.0);  // |offset| = 13
@@ -234,24 +227,29 @@ TEST(RpeTest, BadOptionsAndEmptySelectionsAreUserErrors) {
   const std::vector<SE3> line = along_x(range(0, 10));
   RpeOptions o;
   o.delta = 0;
-  expect_error([&] { rpe(line, line, o); }, "rpe delta must be a finite number > 0, got 0");
+  driftlab::test::expect_user_error([&] { rpe(line, line, o); },
+                                    "rpe delta must be a finite number > 0, got 0");
   o.delta = 1.5;
-  expect_error([&] { rpe(line, line, o); }, "rpe delta in frames must be a whole number, got 1.5");
+  driftlab::test::expect_user_error([&] { rpe(line, line, o); },
+                                    "rpe delta in frames must be a whole number, got 1.5");
   o.delta = 1;
   o.tolerance = -0.1;
-  expect_error([&] { o.validate(); }, "rpe tolerance must be a finite number >= 0, got -0.1");
+  driftlab::test::expect_user_error([&] { o.validate(); },
+                                    "rpe tolerance must be a finite number >= 0, got -0.1");
   o.tolerance = 0.1;
   o.delta = 11;
-  expect_error([&] { rpe(line, line, o); },
-               "RPE: delta = 11 frames gives no pose pair among 11 poses");
+  driftlab::test::expect_user_error([&] { rpe(line, line, o); },
+                                    "RPE: delta = 11 frames gives no pose pair among 11 poses");
   o.unit = DeltaUnit::kMeters;
   o.delta = 20;
-  expect_error([&] { rpe(line, line, o); },
-               "RPE: delta = 20 m gives no pose pair among 11 poses (path along the estimate)");
+  driftlab::test::expect_user_error(
+      [&] { rpe(line, line, o); },
+      "RPE: delta = 20 m gives no pose pair among 11 poses (path along the estimate)");
   o.all_pairs = true;
   o.pairs_from_reference = true;
-  expect_error([&] { rpe(line, line, o); },
-               "(path along the ground truth); try a smaller delta or a larger tolerance");
+  driftlab::test::expect_user_error(
+      [&] { rpe(line, line, o); },
+      "(path along the ground truth); try a smaller delta or a larger tolerance");
 }
 
 }  // namespace

@@ -22,8 +22,6 @@ Trajectory at_stamps(const std::vector<TimeNs>& stamps) {
   return t;
 }
 
-const auto error_of = driftlab::test::user_error_of;
-
 using Ids = std::vector<std::size_t>;
 
 TEST(AssociationTest, JitteredStampsPairWithTheirNearestGroundTruth) {
@@ -48,7 +46,9 @@ TEST(AssociationTest, ToleranceIsInclusiveToTheNanosecond) {
   const Trajectory gt = at_stamps({0, 100 * kMs, 200 * kMs});
   const Trajectory est = at_stamps({120 * kMs});
   EXPECT_EQ(associate(gt, est, 20 * kMs).gt, Ids{1});
-  EXPECT_NE(error_of([&] { associate(gt, est, 20 * kMs - 1); }).find("no pose of estimate"),
+  EXPECT_NE(driftlab::test::user_error_of([&] {
+              associate(gt, est, 20 * kMs - 1);
+            }).find("no pose of estimate"),
             std::string::npos);
   // Zero tolerance: equal stamps only.
   EXPECT_EQ(associate(gt, at_stamps({100 * kMs}), 0).gt, Ids{1});
@@ -104,33 +104,34 @@ TEST(AssociationTest, WithEqualSizesTheEstimateDrives) {
 
 TEST(AssociationTest, BadInputsNameTheTrajectoryAndThePose) {
   const Trajectory good = at_stamps({0, 100 * kMs, 200 * kMs});
-  EXPECT_EQ(error_of([&] { associate(good, {}, kMs, "gt.tum", "vo.tum"); }),
+  EXPECT_EQ(driftlab::test::user_error_of([&] { associate(good, {}, kMs, "gt.tum", "vo.tum"); }),
             "vo.tum: no poses to evaluate");
-  EXPECT_EQ(error_of([&] {
+  EXPECT_EQ(driftlab::test::user_error_of([&] {
               associate(at_stamps({0, 200 * kMs, 100 * kMs}), good, kMs, "gt.tum");
             }),
             "gt.tum: time stamps must strictly increase, but pose 2 at 0.100000000 s comes before "
             "pose 1 at 0.200000000 s");
-  EXPECT_EQ(error_of([&] {
+  EXPECT_EQ(driftlab::test::user_error_of([&] {
               associate(good, at_stamps({0, 100 * kMs, 100 * kMs}), kMs);
             }),
             "estimate: time stamps must strictly increase, but pose 2 at 0.100000000 s repeats the "
             "stamp of pose 1 at 0.100000000 s");
   Trajectory nan = good;
   nan[1].T_W_C = SE3::from_translation(Vec3(1, std::numeric_limits<double>::quiet_NaN(), 2));
-  const std::string msg = error_of([&] { associate(nan, good, kMs); });
+  const std::string msg = driftlab::test::user_error_of([&] { associate(nan, good, kMs); });
   EXPECT_EQ(
       msg.rfind("ground truth: pose 1 at 0.100000000 s is not finite: translation (1, nan, 2)", 0),
       0u)
       << msg;
-  EXPECT_EQ(error_of([&] { associate(good, good, -1); }),
+  EXPECT_EQ(driftlab::test::user_error_of([&] { associate(good, good, -1); }),
             "association tolerance must be >= 0 s, got -0.000000001 s");
 }
 
 TEST(AssociationTest, NoOverlapGivesBothStampSpans) {
   const Trajectory gt = at_stamps({10'000 * kMs, 10'100 * kMs, 12'000 * kMs});
   const Trajectory est = at_stamps({20'000 * kMs, 20'500 * kMs});
-  EXPECT_EQ(error_of([&] { associate(gt, est, 20 * kMs, "groundtruth.tum", "estimates/vo.tum"); }),
+  EXPECT_EQ(driftlab::test::user_error_of(
+                [&] { associate(gt, est, 20 * kMs, "groundtruth.tum", "estimates/vo.tum"); }),
             "no pose of estimates/vo.tum lies within 0.02 s of a pose of groundtruth.tum; the "
             "stamps of estimates/vo.tum span [20.000000000, 20.500000000] s and those of "
             "groundtruth.tum span [10.000000000, 12.000000000] s");

@@ -17,7 +17,7 @@ namespace {
 
 // Relative errors of ~1e-2 built from sums of exact integers and one product
 // by 1.01: rounding only.
-constexpr double kTol = 1e-9;
+constexpr double kSegmentsTol = 1e-9;
 
 // Poses 1 m apart along x, 0 .. 1000 m (1001 poses), so every path length is
 // an exact integer.
@@ -50,8 +50,8 @@ TEST(KittiSegmentsTest, OnePercentScaleErrorOnEveryLength) {
     // Each segment spans L + 1 m of ground truth (the end frame is strictly
     // past L), so the 1 % scale error gives 0.01 (L + 1) m, divided by the
     // nominal L as the devkit does.
-    EXPECT_NEAR(s.trans_err_pct, (L + 1) / L, kTol) << L;
-    EXPECT_NEAR(s.rot_err_deg_per_100m, 0.0, kTol);
+    EXPECT_NEAR(s.trans_err_pct, (L + 1) / L, kSegmentsTol) << L;
+    EXPECT_NEAR(s.rot_err_deg_per_100m, 0.0, kSegmentsTol);
     sum += static_cast<double>(s.count) * (L + 1) / L;
     total += s.count;
   }
@@ -60,7 +60,7 @@ TEST(KittiSegmentsTest, OnePercentScaleErrorOnEveryLength) {
   // The overall figure averages every segment, not the eight length means.
   EXPECT_EQ(r.overall.length_m, 0.0);
   EXPECT_EQ(r.overall.count, total);
-  EXPECT_NEAR(r.overall.trans_err_pct, sum / static_cast<double>(total), kTol);
+  EXPECT_NEAR(r.overall.trans_err_pct, sum / static_cast<double>(total), kSegmentsTol);
   // The vector form returns the same per-length entries.
   const std::vector<KittiSegmentResult> v = kitti_segment_errors(gt, est);
   ASSERT_EQ(v.size(), 8u);
@@ -77,7 +77,7 @@ TEST(KittiSegmentsTest, RotationDriftPerFrameIsReportedPerHundredMetres) {
   for (const KittiSegmentResult& s : r) {
     // L + 1 frames of alpha each, per nominal metre, as degrees per 100 m.
     const double expected = rad2deg(alpha * (s.length_m + 1) / s.length_m) * 100.0;
-    EXPECT_NEAR(s.rot_err_deg_per_100m, expected, kTol) << s.length_m;
+    EXPECT_NEAR(s.rot_err_deg_per_100m, expected, kSegmentsTol) << s.length_m;
   }
 }
 
@@ -91,7 +91,7 @@ TEST(KittiSegmentsTest, CustomLengthsAndStep) {
   const std::vector<KittiSegmentResult> r = kitti_segment_errors(gt, est, {10.0}, 1);
   ASSERT_EQ(r.size(), 1u);
   EXPECT_EQ(r[0].count, 20u);
-  EXPECT_NEAR(r[0].trans_err_pct, 1.1, kTol);
+  EXPECT_NEAR(r[0].trans_err_pct, 1.1, kSegmentsTol);
   // With step 4: f = 0, 4, 8, 12, 16.
   EXPECT_EQ(kitti_segment_errors(gt, est, {10.0}, 4)[0].count, 5u);
 }
@@ -111,17 +111,15 @@ TEST(KittiSegmentsTest, LengthsWithoutASegmentAreLeftOut) {
   EXPECT_TRUE(kitti_errors({}, {}).per_length.empty());
 }
 
-const auto error_of = driftlab::test::user_error_of;
-
 TEST(KittiSegmentsTest, BadOptionsAreUserErrors) {
   const std::vector<SE3> gt = straight_1000m();
-  EXPECT_EQ(error_of([&] {
+  EXPECT_EQ(driftlab::test::user_error_of([&] {
               kitti_errors(gt, gt, {100.0, -5.0});
             }),
             "KITTI segment length 1 must be a finite number > 0 m, got -5");
-  EXPECT_EQ(error_of([&] { kitti_errors(gt, gt, {std::nan("")}); }),
+  EXPECT_EQ(driftlab::test::user_error_of([&] { kitti_errors(gt, gt, {std::nan("")}); }),
             "KITTI segment length 0 must be a finite number > 0 m, got nan");
-  EXPECT_EQ(error_of([&] { kitti_errors(gt, gt, kKittiLengthsM, 0); }),
+  EXPECT_EQ(driftlab::test::user_error_of([&] { kitti_errors(gt, gt, kKittiLengthsM, 0); }),
             "KITTI segment step must be >= 1 frame, got 0");
 }
 

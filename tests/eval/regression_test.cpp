@@ -14,11 +14,12 @@
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::eval {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using driftlab::test::kPi;
 
 // Log relative error: the number of significant digits `got` shares with `certified`, as NIST
 // StRD grades a package (McCullough 1998). Capped at 15 (an exact match).

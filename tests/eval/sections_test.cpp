@@ -12,7 +12,7 @@
 namespace driftlab::eval {
 namespace {
 
-constexpr double kTol = 1e-12;
+constexpr double kSectionsTol = 1e-12;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A camera looking north (optical z = world x) and level: optical x -> east,
@@ -28,7 +28,7 @@ struct Straight {
 };
 
 // 21 poses, 1 m apart northwards, 0.5 s apart.
-Straight straight_line(double est_scale, double est_yaw_drift_rad_per_frame) {
+Straight straight_sections(double est_scale, double est_yaw_drift_rad_per_frame) {
   Straight s;
   for (int i = 0; i <= 20; ++i) {
     s.t.push_back(static_cast<TimeNs>(i) * 500'000'000);
@@ -39,7 +39,7 @@ Straight straight_line(double est_scale, double est_yaw_drift_rad_per_frame) {
 }
 
 TEST(Sections, CutsAtTheFirstPoseAtOrPastTheLength) {
-  const auto s = straight_line(1.0, 0.0);
+  const auto s = straight_sections(1.0, 0.0);
   const auto sections = compute_sections(s.t, s.gt, s.est, {6.5});
   // Poses at 0..20 m: sections [0,7] and [7,14]; [14, 20] is shorter than 6.5 m.
   ASSERT_EQ(sections.size(), 2u);
@@ -48,29 +48,29 @@ TEST(Sections, CutsAtTheFirstPoseAtOrPastTheLength) {
   EXPECT_EQ(sections[1].first, 7u);
   EXPECT_EQ(sections[1].last, 14u);
   EXPECT_DOUBLE_EQ(sections[0].length_m, 7.0);
-  EXPECT_NEAR(sections[0].err_p_m, 0.0, kTol);
-  EXPECT_NEAR(sections[0].covariate("v"), 7.0 / 3.5, kTol);
-  EXPECT_NEAR(sections[0].covariate("h"), 0.0, kTol);
+  EXPECT_NEAR(sections[0].err_p_m, 0.0, kSectionsTol);
+  EXPECT_NEAR(sections[0].covariate("v"), 7.0 / 3.5, kSectionsTol);
+  EXPECT_NEAR(sections[0].covariate("h"), 0.0, kSectionsTol);
 }
 
 TEST(Sections, ScaleErrorGivesItsFractionPerMetre) {
-  const auto s = straight_line(1.1, 0.0);
+  const auto s = straight_sections(1.1, 0.0);
   const auto sections = compute_sections(s.t, s.gt, s.est, {6.5});
   ASSERT_EQ(sections.size(), 2u);
   for (const auto& sec : sections) {
     // Eq. (10) along the optical axis (FRD x): 7 - 7.7 m.
-    EXPECT_NEAR(sec.per_m(sec.err_m.x()), -0.1, kTol);
-    EXPECT_NEAR(sec.per_m(sec.err_m.y()), 0.0, kTol);
-    EXPECT_NEAR(sec.per_m(sec.err_p_m), 0.1, kTol);
+    EXPECT_NEAR(sec.per_m(sec.err_m.x()), -0.1, kSectionsTol);
+    EXPECT_NEAR(sec.per_m(sec.err_m.y()), 0.0, kSectionsTol);
+    EXPECT_NEAR(sec.per_m(sec.err_p_m), 0.1, kSectionsTol);
   }
   const SectionSummary sum = summarize_sections(sections);
-  EXPECT_NEAR(sum.p_m_per_m.mean, 0.1, kTol);
+  EXPECT_NEAR(sum.p_m_per_m.mean, 0.1, kSectionsTol);
   EXPECT_EQ(sum.p_m_per_m.n, 2u);
 }
 
 TEST(Sections, YawDriftGivesAnalyticTranslationAndYawErrors) {
   const double d = 0.01;  // rad of extra yaw per frame in the estimate
-  const auto s = straight_line(1.0, d);
+  const auto s = straight_sections(1.0, d);
   const auto sections = compute_sections(s.t, s.gt, s.est, {6.5});
   ASSERT_EQ(sections.size(), 2u);
   for (const auto& sec : sections) {
@@ -90,7 +90,7 @@ TEST(Sections, YawDriftGivesAnalyticTranslationAndYawErrors) {
 }
 
 TEST(Sections, CovariatesFromTheFrameTable) {
-  const auto s = straight_line(1.0, 0.0);
+  const auto s = straight_sections(1.0, 0.0);
   FrameTable frames;
   frames.names = {"yaw_deg", "inliers", "mean_depth_m", "gps_satellites"};
   frames.columns.resize(4);
@@ -107,13 +107,13 @@ TEST(Sections, CovariatesFromTheFrameTable) {
   const Section& a = sections[0];
   // Rows 0..7 inclusive: yaw 178, 180, ..., 192 -> sample SD of 2*(0..7) = 2*sqrt(6).
   EXPECT_NEAR(a.covariate("h"), 2.0 * std::sqrt(6.0), 1e-9);
-  EXPECT_NEAR(a.covariate("f"), 103.5, kTol);
-  EXPECT_NEAR(a.covariate("d"), 15.0, kTol);
-  EXPECT_NEAR(a.covariate("gps_satellites"), (7 * 3.0 + 8.0) / 8.0, kTol);
+  EXPECT_NEAR(a.covariate("f"), 103.5, kSectionsTol);
+  EXPECT_NEAR(a.covariate("d"), 15.0, kSectionsTol);
+  EXPECT_NEAR(a.covariate("gps_satellites"), (7 * 3.0 + 8.0) / 8.0, kSectionsTol);
   EXPECT_TRUE(std::isnan(a.covariate("inliers")));  // it became f
   const Summary f = summarize_covariate(sections, "f");
   EXPECT_EQ(f.n, 2u);
-  EXPECT_NEAR(f.mean, (103.5 + 110.5) / 2.0, kTol);
+  EXPECT_NEAR(f.mean, (103.5 + 110.5) / 2.0, kSectionsTol);
 }
 
 TEST(Sections, ARunsFrameTableGivesEachVoItsCovariates) {

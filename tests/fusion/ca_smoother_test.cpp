@@ -18,11 +18,12 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "core/yaml_io.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::fusion {
 namespace {
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
+using driftlab::test::kEps;
 constexpr TimeNs kStepNs = 100'000'000;  // 10 Hz, the river paper's frame rate
 constexpr double kDt = 0.1;
 // Fixed-point iterations and the filter's own recursion agree to rounding, amplified by the

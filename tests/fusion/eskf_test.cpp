@@ -27,11 +27,12 @@
 #include "sim/sensors/imu.hpp"
 #include "sim/vessel/simulator.hpp"
 #include "sim/waves/wave_field.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::fusion {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using driftlab::test::kDeg;
 constexpr double kImuRateHz = 200.0;
 constexpr double kCameraRateHz = 13.0;  // the default camera: frames fall between IMU samples
 constexpr int kCompassEvery = 20;       // 10 Hz

@@ -28,11 +28,12 @@
 #include "core/rng.hpp"
 #include "core/rotation.hpp"
 #include "core/time.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::fusion {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using driftlab::test::kDeg;
 
 // ---------------------------------------------------------------------------------------------
 // The scenario: the analytic truth and exact measurements of it.

@@ -25,18 +25,19 @@
 #include "core/rng.hpp"
 #include "core/rotation.hpp"
 #include "core/yaml_io.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::fusion {
 namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
-constexpr TimeNs kStepNs = 50'000'000;  // 20 Hz, the basin paper's frame rate
-constexpr double kDt = 0.05;
+using driftlab::test::kEps;
+constexpr TimeNs kNedStepNs = 50'000'000;  // 20 Hz, the basin paper's frame rate
+constexpr double kNedDt = 0.05;
 // The filter's recursion (Joseph form) and the textbook recursion iterated here agree to
 // rounding, amplified by the few hundred steps of the recursion's memory.
-constexpr double kRiccatiRelTol = 1e-9;
+constexpr double kNedRiccatiRelTol = 1e-9;
 // Dense normal equations of ~300 unknowns with condition ~1e6 against the recursion.
 constexpr double kBatchRelTol = 1e-7;
 
@@ -45,16 +46,16 @@ using Vec = Eigen::VectorXd;
 
 BodyVelocityMeasurement vo_at(int k, double u, double v, double r, bool valid = true) {
   BodyVelocityMeasurement m;
-  m.t_ns = k * kStepNs;
+  m.t_ns = k * kNedStepNs;
   m.valid = valid;
-  m.dt_s = kDt;
+  m.dt_s = kNedDt;
   m.surge_m_s = u;
   m.sway_m_s = v;
   m.yaw_rate_rad_s = r;
   return m;
 }
 
-HeadingMeasurement heading_at(int k, double psi) { return {k * kStepNs, psi}; }
+HeadingMeasurement heading_at(int k, double psi) { return {k * kNedStepNs, psi}; }
 
 bool finite(const NedEstimate& e) { return e.x.allFinite() && e.P.allFinite(); }
 
@@ -78,10 +79,10 @@ NedVector q_diag(const NedFilterOptions& o, double dt, double psi_input_var) {
 }
 
 double r_uv(const NedFilterOptions& o) {
-  return (*o.vo_increment_noise_m / kDt) * (*o.vo_increment_noise_m / kDt);
+  return (*o.vo_increment_noise_m / kNedDt) * (*o.vo_increment_noise_m / kNedDt);
 }
 
-void expect_rel_near(double actual, double expected, double rel, const std::string& what) {
+void ned_expect_rel_near(double actual, double expected, double rel, const std::string& what) {
   EXPECT_NEAR(actual, expected, rel * std::abs(expected) + 1e-300) << what;
 }
 
@@ -117,7 +118,7 @@ TEST(BodyVelocityFromVo, RecoversBodyVelocitiesAndYawRateThroughTheMount) {
 // ---------------------------------------------------------------------------------------------
 // Kalman filter: Riccati and batch least squares
 
-struct SteadyState {
+struct NedSteadyState {
   NedMatrix P;  // posterior
 };
 
@@ -162,21 +163,22 @@ TEST(NedKalmanFilterTest, CovarianceConvergesToTheDiscreteRiccatiSolution) {
   const double var_dpsi = *o.vo_yaw_increment_noise_rad * *o.vo_yaw_increment_noise_rad;
   Eigen::Matrix<double, 3, 5> H = Eigen::Matrix<double, 3, 5>::Zero();
   H(0, 2) = H(1, 3) = H(2, 4) = 1.0;
-  const NedVector q = q_diag(o, kDt, var_dpsi);
+  const NedVector q = q_diag(o, kNedDt, var_dpsi);
   const Eigen::Vector3d r(r_uv(o), r_uv(o), *o.compass_noise_rad * *o.compass_noise_rad);
-  const NedMatrix P = solve_riccati(phi_at(psi0, kDt), q, H, r);
+  const NedMatrix P = solve_riccati(phi_at(psi0, kNedDt), q, H, r);
   // North and east are never measured: their variance grows without bound; the rest converges.
   for (int i = 2; i < 5; ++i) {
     for (int j = 2; j < 5; ++j) {
-      expect_rel_near(e.P(i, j), P(i, j), kRiccatiRelTol,
-                      "P(" + std::to_string(i) + "," + std::to_string(j) + ")");
+      ned_expect_rel_near(e.P(i, j), P(i, j), kNedRiccatiRelTol,
+                          "P(" + std::to_string(i) + "," + std::to_string(j) + ")");
     }
   }
   // The heading filter alone is a scalar random walk measured directly: its steady prior
   // variance solves Pp^2 - q Pp - q r = 0, and the posterior is Pp r / (Pp + r).
   const double qh = q(4), rh = r(2);
   const double Pp = 0.5 * (qh + std::sqrt(qh * qh + 4.0 * qh * rh));
-  expect_rel_near(e.P(4, 4), Pp * rh / (Pp + rh), kRiccatiRelTol, "closed-form heading variance");
+  ned_expect_rel_near(e.P(4, 4), Pp * rh / (Pp + rh), kNedRiccatiRelTol,
+                      "closed-form heading variance");
   EXPECT_LT(e.P(2, 2), r(0));  // the smoothing: better than one VO velocity
   // Position uncertainty grows by about q_p dt + u-coupling per step.
   const NedEstimate next = kf.step(vo_at(4000, 1.0, 0.0, 0.0), heading_at(4000, psi0));
@@ -266,14 +268,14 @@ TEST(NedKalmanFilterTest, EqualsTheBatchLeastSquaresSolutionOfTheSameData) {
     const bool valid = !(k >= 20 && k < 24);
     if (k > 0) {
       const auto kk = static_cast<std::size_t>(k);
-      bp.F[kk] = phi_at(psi_true + 0.5 * r * kDt, kDt);
+      bp.F[kk] = phi_at(psi_true + 0.5 * r * kNedDt, kNedDt);
       bp.b[kk] = NedVector::Zero();
-      bp.b[kk](4) = r * kDt;
-      const double var_dpsi =
-          valid ? *o.vo_yaw_increment_noise_rad * *o.vo_yaw_increment_noise_rad
-                : (o.unmeasured_yaw_rate_sd_rad_s * kDt) * (o.unmeasured_yaw_rate_sd_rad_s * kDt);
-      bp.q[kk] = q_diag(o, kDt, var_dpsi);
-      psi_true += r * kDt;
+      bp.b[kk](4) = r * kNedDt;
+      const double var_dpsi = valid ? *o.vo_yaw_increment_noise_rad * *o.vo_yaw_increment_noise_rad
+                                    : (o.unmeasured_yaw_rate_sd_rad_s * kNedDt) *
+                                          (o.unmeasured_yaw_rate_sd_rad_s * kNedDt);
+      bp.q[kk] = q_diag(o, kNedDt, var_dpsi);
+      psi_true += r * kNedDt;
     }
     const double u = 0.8 + rng.normal(0.0, 0.1), v = 0.05 + rng.normal(0.0, 0.1);
     bp.vo_valid.push_back(valid);
@@ -318,16 +320,16 @@ TEST(NedKalmanFilterTest, PredictionIsEquationsTwoAndThreeWithOrWithoutTheHeadin
     const NedMatrix P0 = kf.covariance();
     kf.step(vo_at(0, 0.0, 0.0, 0.0, false));
     const NedEstimate e = kf.step(vo_at(1, 0.0, 0.0, 0.0, false));
-    NedMatrix F = phi_at(0.4, kDt);  // no yaw rate yet: the held rate is 0
+    NedMatrix F = phi_at(0.4, kNedDt);  // no yaw rate yet: the held rate is 0
     if (jacobian) {
-      F(0, 4) = -kDt * (1.5 * std::sin(0.4) + -0.3 * std::cos(0.4));
-      F(1, 4) = kDt * (1.5 * std::cos(0.4) - -0.3 * std::sin(0.4));
+      F(0, 4) = -kNedDt * (1.5 * std::sin(0.4) + -0.3 * std::cos(0.4));
+      F(1, 4) = kNedDt * (1.5 * std::cos(0.4) - -0.3 * std::sin(0.4));
     }
-    const double s = o.unmeasured_yaw_rate_sd_rad_s * kDt;
-    const NedMatrix P1 = F * P0 * F.transpose() + NedMatrix(q_diag(o, kDt, s * s).asDiagonal());
+    const double s = o.unmeasured_yaw_rate_sd_rad_s * kNedDt;
+    const NedMatrix P1 = F * P0 * F.transpose() + NedMatrix(q_diag(o, kNedDt, s * s).asDiagonal());
     NedVector x1 = init.vector();
-    x1(0) += kDt * (1.5 * std::cos(0.4) + 0.3 * std::sin(0.4));
-    x1(1) += kDt * (1.5 * std::sin(0.4) - 0.3 * std::cos(0.4));
+    x1(0) += kNedDt * (1.5 * std::cos(0.4) + 0.3 * std::sin(0.4));
+    x1(1) += kNedDt * (1.5 * std::sin(0.4) - 0.3 * std::cos(0.4));
     EXPECT_LT((e.x - x1).norm(), 1e-14) << jacobian;
     EXPECT_LT((e.P - P1).norm(), 1e-14 * P1.norm()) << jacobian;
     EXPECT_EQ(e.P(0, 4) != 0.0, jacobian);  // only the EKF couples position and heading
@@ -348,10 +350,10 @@ struct LinearRun {
 LinearRun linear_run(int steps, std::uint64_t seed, const NedFilterOptions& o, double psi0) {
   LinearRun run;
   Rng rng = RngStreams(seed).stream("test.ned.data");
-  const double su = *o.vo_increment_noise_m / kDt;
+  const double su = *o.vo_increment_noise_m / kNedDt;
   for (int k = 0; k < steps; ++k) {
     run.vo.push_back(vo_at(k, 1.0 + rng.normal(0, su), 0.1 + rng.normal(0, su),
-                           rng.normal(0.0, *o.vo_yaw_increment_noise_rad / kDt), k % 17 != 9));
+                           rng.normal(0.0, *o.vo_yaw_increment_noise_rad / kNedDt), k % 17 != 9));
     run.heading.push_back(heading_at(k, psi0 + rng.normal(0.0, *o.compass_noise_rad)));
   }
   return run;
@@ -588,13 +590,13 @@ TEST(NedParticleFilterTest, PaperAverageLikelihoodIsTheAverageOfTheComponentDens
 // A turning vessel with realistic noise
 
 // One step of a vessel turning at a constant rate r with body velocities (u, v): the true
-// state x = [N, E, u, v, psi] moves by kDt (heading at the step's midpoint).
+// state x = [N, E, u, v, psi] moves by kNedDt (heading at the step's midpoint).
 void advance_turning_truth(NedVector* x, double u, double v, double r) {
   NedVector& s = *x;
-  const double psi_m = s(4) + 0.5 * r * kDt;
-  s(0) += kDt * (u * std::cos(psi_m) - v * std::sin(psi_m));
-  s(1) += kDt * (u * std::sin(psi_m) + v * std::cos(psi_m));
-  s(4) = wrap_angle_rad(s(4) + r * kDt);
+  const double psi_m = s(4) + 0.5 * r * kNedDt;
+  s(0) += kNedDt * (u * std::cos(psi_m) - v * std::sin(psi_m));
+  s(1) += kNedDt * (u * std::sin(psi_m) + v * std::cos(psi_m));
+  s(4) = wrap_angle_rad(s(4) + r * kNedDt);
 }
 
 // Adds the squared error of each state of `e` against the truth (heading wrapped) to `se`.
@@ -615,14 +617,14 @@ TEST(NedFiltersTest, TrackATurningVesselBetterThanTheRawMeasurements) {
   NedParticleFilterOptions po;
   po.resampling = PfResampling::kSystematicEss;
   NedParticleFilter pf(po, rng, NedState{.surge_m_s = u, .sway_m_s = v, .heading_rad = 1.0});
-  const double su = *o.vo_increment_noise_m / kDt;
+  const double su = *o.vo_increment_noise_m / kNedDt;
   NedVector se_kf = NedVector::Zero(), se_pf = NedVector::Zero();
   double se_raw_u = 0, se_raw_psi = 0;
   constexpr int kSteps = 1200;  // a minute at 20 Hz, 275 deg of turn
   for (int k = 0; k < kSteps; ++k) {
     if (k > 0) advance_turning_truth(&x, u, v, r);
     const double um = u + rng.normal(0, su), vm = v + rng.normal(0, su);
-    const double rm = r + rng.normal(0, *o.vo_yaw_increment_noise_rad / kDt);
+    const double rm = r + rng.normal(0, *o.vo_yaw_increment_noise_rad / kNedDt);
     std::optional<HeadingMeasurement> h;
     if (k % 2 == 0) h = heading_at(k, wrap_angle_rad(x(4) + rng.normal(0, *o.compass_noise_rad)));
     const bool valid = k % 40 != 39;
@@ -665,8 +667,8 @@ TEST(NedFiltersTest, NullVoNoiseIsEstimatedFromTheVoAndTracksAsWellAsTheTrueNois
   const double u = 1.2, v = -0.1, r = 0.08;
   const NedState init{.surge_m_s = u, .sway_m_s = v, .heading_rad = 1.0};
   NedKalmanFilter told(truth, init), guessing(estimated, init);
-  const double su = *truth.vo_increment_noise_m / kDt;
-  const double sr = *truth.vo_yaw_increment_noise_rad / kDt;
+  const double su = *truth.vo_increment_noise_m / kNedDt;
+  const double sr = *truth.vo_yaw_increment_noise_rad / kNedDt;
   NedVector x;
   x << 0.0, 0.0, u, v, 1.0;
   NedVector se_told = NedVector::Zero(), se_guess = NedVector::Zero();
@@ -725,7 +727,7 @@ TEST(SecondDifferenceNoise, FindsWhiteNoiseOnASmoothSignalDespiteOutliersAndGaps
   SecondDifferenceNoise all(2, 4000), windowed(2);
   EXPECT_FALSE(windowed.sigma().has_value());
   for (int k = 0; k < 2000; ++k) {
-    const double t = k * kDt;
+    const double t = k * kNedDt;
     for (std::size_t c = 0; c < 2; ++c) {
       double x = 0.05 * std::sin(2.0 * std::numbers::pi * t / 0.8 + static_cast<double>(c)) +
                  rng.normal(0.0, sigma);
@@ -788,7 +790,7 @@ TEST(NedFiltersTest, InvalidVoFramesAreSkippedWithoutNan) {
   EXPECT_EQ(pf.nonfinite_guards(), 0);
   // A "valid" measurement that breaks the promise of finite values is caught and counted.
   BodyVelocityMeasurement broken = vo_at(60, std::nan(""), 0.0, 0.0);
-  EXPECT_TRUE(finite(kf.step(broken, HeadingMeasurement{60 * kStepNs, std::nan("")})));
+  EXPECT_TRUE(finite(kf.step(broken, HeadingMeasurement{60 * kNedStepNs, std::nan("")})));
   EXPECT_TRUE(finite(pf.step(broken)));
   EXPECT_EQ(kf.nonfinite_guards(), 2);
   EXPECT_EQ(pf.nonfinite_guards(), 1);

@@ -60,8 +60,8 @@ sim::SceneGeometry wall_scene(double north_m, double east_m, double lean = 0.0) 
   return s;
 }
 
-struct Rendering {
-  Rendering(const Scenario& sc, const sim::SceneGeometry& scene)
+struct TimingRendering {
+  TimingRendering(const Scenario& sc, const sim::SceneGeometry& scene)
       : renderer(rig_of(sc.sensors.camera), sc.render) {
     renderer.upload(scene);
   }
@@ -164,7 +164,7 @@ TEST(CameraTiming, RollingShutterShearsAVerticalEdgeUnderAYawRate) {
   Scenario sc = ps3_eye_scenario();
   const auto& cam = sc.sensors.camera;
   const double w = 0.5, north = 4.0, east = 0.3;
-  Rendering r(sc, wall_scene(north, east, kLean));
+  TimingRendering r(sc, wall_scene(north, east, kLean));
   CameraStage stage(sc, &r.renderer, RngStreams(1));
   Vec6 twist;
   twist << 0, 0, 0, 0, 0, w;
@@ -199,7 +199,7 @@ TEST(CameraTiming, RollingShutterShiftsRowsByTheirOwnTranslation) {
   Scenario sc = ps3_eye_scenario();
   const auto& cam = sc.sensors.camera;
   const double v = 1.0, north = 3.0, east = 0.2;
-  Rendering r(sc, wall_scene(north, east, kLean));
+  TimingRendering r(sc, wall_scene(north, east, kLean));
   CameraStage stage(sc, &r.renderer, RngStreams(1));
   Vec6 twist;
   twist << 0, v, 0, 0, 0, 0;  // body FRD: y is starboard, east when heading north
@@ -225,7 +225,7 @@ TEST(CameraTiming, AnUnsynchronisedRightImageSeesTheRigWhereItIsAtItsOwnTime) {
   cam.shutter = sim::Shutter::kGlobal;
   cam.right_offset_ms = 10;
   const double v = 1.0, north = 3.0, east = 0.2;
-  Rendering r(sc, wall_scene(north, east, kLean));
+  TimingRendering r(sc, wall_scene(north, east, kLean));
   Vec6 twist;
   twist << 0, v, 0, 0, 0, 0;
   CameraStage stage(sc, &r.renderer, RngStreams(1));
@@ -269,7 +269,7 @@ TEST(CameraTiming, AFreeRunningPairDrawsItsOffsetPerRunAndJittersPerFrame) {
   sc.sensors.camera.cy_px = 23.5;
   sc.sensors.camera.right_offset_ms = 2;
   sc.sensors.camera.right_offset_jitter_ms = 1;
-  Rendering r(sc, wall_scene(4, 0));
+  TimingRendering r(sc, wall_scene(4, 0));
   CameraStage stage(sc, &r.renderer, RngStreams(3));
   double s = 0, ss = 0;
   const int frames = 400;

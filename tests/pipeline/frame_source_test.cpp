@@ -22,12 +22,12 @@ namespace driftlab::pipeline {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kSource = DRIFTLAB_SOURCE_DIR;
+const fs::path kFrameSourceDir = DRIFTLAB_SOURCE_DIR;
 
 // A short, noisy, auto-exposed look across the river: every camera effect that keeps state
 // from frame to frame (noise streams, exposure) is on.
 struct RiverLook {
-  RiverLook() : sc(load_scenario(kSource / "scenarios/river_crossing.yaml")) {
+  RiverLook() : sc(load_scenario(kFrameSourceDir / "scenarios/river_crossing.yaml")) {
     sc.sensors.camera.auto_exposure.enabled = true;
     scene = scenes::build_scene(sc.scene, sc.seed, -10, 30);
     for (int k = 0; k < 8; ++k) {

@@ -17,7 +17,7 @@
 namespace driftlab::pipeline {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using driftlab::test::kPi;
 
 // Where the camera at C sees a point p on the horizontal plane at height z: the ray's
 // crossing, as a perfectly calibrated overhead camera maps it.
@@ -84,9 +84,9 @@ TEST(OverheadStage, TrackedMarkersLandWhereTheirRaysCrossTheMarkerPlane) {
 TEST(OverheadStage, RefusedOutsideABasin) {
   Scenario sc = load_scenario(test::source_dir() / "scenarios" / "basin_exp1.yaml", {});
   sc.scene.type = scenes::SceneType::kRiverReach;
-  const std::string message = test::user_error_of([&] { overhead_camera_pose(sc); });
+  const std::string message = driftlab::test::user_error_of([&] { overhead_camera_pose(sc); });
   EXPECT_NE(message.find("expected scene.type wave_basin"), std::string::npos) << message;
-  const std::string invalid = test::user_error_of([&] { validate_scenario(sc, "s"); });
+  const std::string invalid = driftlab::test::user_error_of([&] { validate_scenario(sc, "s"); });
   EXPECT_NE(invalid.find("sensors.overhead.enabled with scene.type: got true with river_reach"),
             std::string::npos)
       << invalid;

@@ -26,7 +26,7 @@ namespace {
 using test::slurp;
 
 namespace fs = std::filesystem;
-const fs::path kSource = DRIFTLAB_SOURCE_DIR;
+const fs::path kRunSourceDir = DRIFTLAB_SOURCE_DIR;
 
 fs::path temp_dir(const std::string& name) {
   const fs::path d =
@@ -49,7 +49,7 @@ TEST(CameraMount, NominalLooksAlongTheBowAndYawTurnsItToStarboard) {
 }
 
 Scenario short_crossing(int frames) {
-  Scenario s = load_scenario(kSource / "scenarios/river_crossing.yaml");
+  Scenario s = load_scenario(kRunSourceDir / "scenarios/river_crossing.yaml");
   s.pipeline.max_frames = frames;
   return s;
 }
@@ -170,7 +170,7 @@ TEST(Run, SameBytesWhateverTheThreadCountWithARollingShutterAndAFreeRunningPair)
   // the run's drawn offset) on waves give the same estimates and per-frame rows at 1 and 2
   // threads.
   const fs::path a = temp_dir("rolling1"), b = temp_dir("rolling2");
-  Scenario sc = load_scenario(kSource / "scenarios/basin_exp3.yaml");
+  Scenario sc = load_scenario(kRunSourceDir / "scenarios/basin_exp3.yaml");
   ASSERT_EQ(sc.sensors.camera.shutter, sim::Shutter::kRolling);
   sc.pipeline.max_frames = 30;
   sc.sensors.camera.right_offset_jitter_ms = 0.5;
@@ -289,7 +289,7 @@ TEST(Run, SensorsSampleAtTheirRatesFromTheSameGroundTruth) {
 
 TEST(Run, WholeDischargeMeasurementMission) {
   const fs::path out = temp_dir("mission");
-  Scenario sc = load_scenario(kSource / "scenarios/river_crossing.yaml");
+  Scenario sc = load_scenario(kRunSourceDir / "scenarios/river_crossing.yaml");
   RunSummary sum = run_scenario(sc, out, {.only_motion = true, .frame_cache = {}});
   EXPECT_TRUE(sum.motion.mission_completed);
   // Over 300 s of mission (54 m at 0.17 m/s plus the turns), a frame per camera period.
@@ -314,7 +314,7 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   // The shipped river_crossing scenario (both sparse VOs, the smoother, every camera effect of
   // the defaults) on a straight calm leg: only the mission and its length are changed.
   const fs::path out = temp_dir("e2e");
-  Scenario sc = load_scenario(kSource / "scenarios/river_crossing.yaml");
+  Scenario sc = load_scenario(kRunSourceDir / "scenarios/river_crossing.yaml");
   ASSERT_EQ(sc.water.waves.model, sim::WaveModel::kCalm);
   ASSERT_EQ(sc.pipeline.vo, (std::vector<std::string>{"sparse", "sparse_kf"}));
   sc.mission.type = sim::MissionType::kStraight;
@@ -426,7 +426,7 @@ namespace {
 
 TEST(Run, EachFilterIsSetAgainstItsRawVoAndOneThatDoesNotHelpSaysSo) {
   const fs::path out = temp_dir("filters_vs_vo");
-  Scenario sc = load_scenario(kSource / "scenarios/basin_exp4.yaml");
+  Scenario sc = load_scenario(kRunSourceDir / "scenarios/basin_exp4.yaml");
   sc.pipeline.max_frames = 80;
   sc.pipeline.vo = {"pnp"};
   sc.pipeline.fusion = {FusionAlgorithm::kCaSmoother, FusionAlgorithm::kNedKf,
@@ -503,7 +503,7 @@ TEST(Run, EachFilterIsSetAgainstItsRawVoAndOneThatDoesNotHelpSaysSo) {
 
 TEST(Run, StagesSayWhatRanAndTheBackwardPassWritesItsOwnEstimate) {
   const fs::path a = temp_dir("stages_a"), b = temp_dir("stages_b");
-  Scenario sc = load_scenario(kSource / "scenarios/river_crossing.yaml");
+  Scenario sc = load_scenario(kRunSourceDir / "scenarios/river_crossing.yaml");
   sc.pipeline.max_frames = 30;
   sc.pipeline.vo = {"sparse"};
   sc.pipeline.fusion = {};

@@ -16,7 +16,7 @@ namespace driftlab::pipeline {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kSource = DRIFTLAB_SOURCE_DIR;
+const fs::path kScenarioSourceDir = DRIFTLAB_SOURCE_DIR;
 
 std::string error_of(const std::string& text, const std::vector<std::string>& sets = {}) {
   try {
@@ -34,7 +34,7 @@ TEST(Scenario, DefaultsAreValid) {
 }
 
 TEST(Scenario, LoadsTheDemoScenario) {
-  const Scenario s = load_scenario(kSource / "scenarios/river_crossing.yaml");
+  const Scenario s = load_scenario(kScenarioSourceDir / "scenarios/river_crossing.yaml");
   EXPECT_EQ(s.name, "river_crossing");
   EXPECT_EQ(s.seed, 2013u);
   EXPECT_EQ(s.mission.type, sim::MissionType::kTransects);
@@ -51,7 +51,7 @@ TEST(Scenario, LoadsTheDemoScenario) {
 
 TEST(Scenario, CameraPresetsAreThePapersCamerasAndLaterKeysOverrideThem) {
   // River paper Sec. 2.1: Bumblebee2, 1024x768, 0.12 m, 8.2 Hz; 3.8 mm lens on 4.65 um pixels.
-  const Scenario river = load_scenario(kSource / "scenarios/river_crossing.yaml");
+  const Scenario river = load_scenario(kScenarioSourceDir / "scenarios/river_crossing.yaml");
   const sim::CameraOptions& c = river.sensors.camera;
   EXPECT_EQ(c.preset, sim::CameraPreset::kBumblebee2);
   EXPECT_EQ(c.width_px, 1024);
@@ -63,10 +63,11 @@ TEST(Scenario, CameraPresetsAreThePapersCamerasAndLaterKeysOverrideThem) {
   EXPECT_DOUBLE_EQ(c.baseline_m, 0.12);
   EXPECT_DOUBLE_EQ(c.rate_hz, 8.2);
   EXPECT_NEAR(2 * std::atan(512 / c.fx_px) * 180 / std::numbers::pi, 64.1, 0.1);
-  EXPECT_EQ(load_scenario(kSource / "scenarios/river_survey.yaml").sensors.camera.preset,
+  EXPECT_EQ(load_scenario(kScenarioSourceDir / "scenarios/river_survey.yaml").sensors.camera.preset,
             sim::CameraPreset::kBumblebee2);
   // Basin paper Sec. 2.2: PlayStation Eye pair, 640x480 at 20 Hz; 75 deg diagonal field of view.
-  const sim::CameraOptions b = load_scenario(kSource / "scenarios/basin_exp1.yaml").sensors.camera;
+  const sim::CameraOptions b =
+      load_scenario(kScenarioSourceDir / "scenarios/basin_exp1.yaml").sensors.camera;
   EXPECT_EQ(b.preset, sim::CameraPreset::kPs3Eye);
   EXPECT_EQ(b.width_px, 640);
   EXPECT_NEAR(2 * std::atan(400 / b.fx_px) * 180 / std::numbers::pi, 75.0, 0.1);
@@ -81,10 +82,11 @@ TEST(Scenario, CameraPresetsAreThePapersCamerasAndLaterKeysOverrideThem) {
   EXPECT_EQ(c.right_offset_spread_ms, 0.0);
   // Keys after the preset override it; custom leaves the defaults.
   const Scenario o = parse_scenario(
-      "sensors:\n  camera:\n    preset: bumblebee2\n    rate_hz: 15\n", "o", kSource);
+      "sensors:\n  camera:\n    preset: bumblebee2\n    rate_hz: 15\n", "o", kScenarioSourceDir);
   EXPECT_EQ(o.sensors.camera.width_px, 1024);
   EXPECT_DOUBLE_EQ(o.sensors.camera.rate_hz, 15.0);
-  const Scenario d = parse_scenario("sensors:\n  camera:\n    preset: custom\n", "d", kSource);
+  const Scenario d =
+      parse_scenario("sensors:\n  camera:\n    preset: custom\n", "d", kScenarioSourceDir);
   EXPECT_EQ(d.sensors.camera.width_px, sim::CameraOptions{}.width_px);
   EXPECT_EQ(d.sensors.camera.fx_px, sim::CameraOptions{}.fx_px);
 }
@@ -94,8 +96,8 @@ TEST(Scenario, BasinExperimentsMatchThePaperTable) {
   const double table[7][3] = {{0, 0, 0},   {40, 5, 210},  {40, 7.5, 132}, {40, 11, 59},
                               {0, 5, 210}, {0, 7.5, 132}, {0, 11, 59}};
   for (int i = 0; i < 7; ++i) {
-    const Scenario s =
-        load_scenario(kSource / ("scenarios/basin_exp" + std::to_string(i + 1) + ".yaml"));
+    const Scenario s = load_scenario(kScenarioSourceDir /
+                                     ("scenarios/basin_exp" + std::to_string(i + 1) + ".yaml"));
     SCOPED_TRACE(s.name);
     EXPECT_EQ(s.scene.type, scenes::SceneType::kWaveBasin);
     EXPECT_DOUBLE_EQ(s.sensors.camera.rate_hz, 20.0);
@@ -132,7 +134,8 @@ TEST(Scenario, CrossFieldRulesHoldAfterAllOverrides) {
 
 TEST(Scenario, ResolvedYamlRoundTripsByteForByte) {
   for (const char* name : {"river_crossing", "river_survey", "basin_exp4"}) {
-    const Scenario s = load_scenario(kSource / "scenarios" / (std::string(name) + ".yaml"));
+    const Scenario s =
+        load_scenario(kScenarioSourceDir / "scenarios" / (std::string(name) + ".yaml"));
     const std::string text = resolved_yaml(s);
     const Scenario back = parse_scenario(text, "resolved", fs::temp_directory_path());
     EXPECT_EQ(resolved_yaml(back), text) << name;
@@ -224,8 +227,11 @@ TEST(Scenario, WavesSteeperThanBreakingAreFlaggedWithTheMicheLimit) {
   EXPECT_EQ(warnings(0.5, shallow_limit_m * 0.99, 10), "");
   EXPECT_NE(warnings(0.5, shallow_limit_m * 1.01, 10).find("(Miche)"), std::string::npos);
   // The basin paper's experiment 4 (Table 1: 11 mm on a 59 mm wavelength) is such a wave.
-  EXPECT_EQ(implausible_values(load_scenario(kSource / "scenarios/basin_exp4.yaml")).size(), 1u);
-  EXPECT_TRUE(implausible_values(load_scenario(kSource / "scenarios/basin_exp2.yaml")).empty());
+  EXPECT_EQ(
+      implausible_values(load_scenario(kScenarioSourceDir / "scenarios/basin_exp4.yaml")).size(),
+      1u);
+  EXPECT_TRUE(
+      implausible_values(load_scenario(kScenarioSourceDir / "scenarios/basin_exp2.yaml")).empty());
 }
 
 // A box hull floats at draft m / (rho L B): 55 kg in 1.95 x 0.73 m draws 38.6 mm, so with

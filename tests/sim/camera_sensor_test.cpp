@@ -15,11 +15,12 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "sim/sensors/camera_effects.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using driftlab::test::kDeg;
 
 CameraOptions small_camera(int w = 160, int h = 120) {
   CameraOptions c;

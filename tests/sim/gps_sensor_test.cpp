@@ -14,12 +14,13 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "sim/sensors/gps.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDeg = std::numbers::pi / 180.0;
+using driftlab::test::kDeg;
 constexpr double kA = 6378137.0;          // WGS84 semi-major axis [m]
 constexpr double kB = 6356752.314245179;  // WGS84 semi-minor axis [m], a (1 - f)
 constexpr double kE2 = 6.69437999014e-3;  // WGS84 first eccentricity squared

@@ -16,12 +16,13 @@
 #include "sim/sensors/imu.hpp"
 #include "sim/vessel/simulator.hpp"
 #include "sim/waves/wave_field.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {
 namespace {
 
 constexpr double kG = 9.80665;  // standard gravity, written out: the test's own constant
-constexpr double kDeg = std::numbers::pi / 180.0;
+using driftlab::test::kDeg;
 
 Mat3 rot_zyx(double roll, double pitch, double yaw) {
   return (Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * Eigen::AngleAxisd(pitch, Vec3::UnitY()) *

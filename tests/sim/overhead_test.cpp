@@ -1,6 +1,7 @@
 // The basin paper's tracker and its Eqs. (11)-(20) (sim/sensors/overhead.hpp), against
 // drawn markers and closed forms.
 #include "sim/sensors/overhead.hpp"
+#include "tests/support/test_support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +12,7 @@
 namespace driftlab::sim {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using driftlab::test::kPi;
 
 // A gray hall floor, a white hull and two round marks at sub-pixel centres (OpenCV draws with
 // 8 fractional bits), red and green as the renderer's materials shade them.

@@ -92,8 +92,8 @@ SceneGeometry checker_disc_over_water(const Vec3& centre, double radius, std::ui
   return s;
 }
 
-// Intensity-weighted centroid of an image.
-Eigen::Vector2d centroid(const GrayImage& img) {
+// Intensity-weighted bright_centroid of an image.
+Eigen::Vector2d bright_centroid(const GrayImage& img) {
   double sx = 0, sy = 0, s = 0;
   for (int y = 0; y < img.height; ++y)
     for (int x = 0; x < img.width; ++x) {
@@ -181,7 +181,7 @@ TYPED_TEST(RenderTest, MarkerLandsOnItsPinholeProjectionInBothImages) {
   const Vec3 p_C = T_W_C.inverse() * marker;
   const Eigen::Vector2d uv = rig.camera.project(p_C);
   const Eigen::Vector2d uv_r = rig.project_right(p_C);
-  const Eigen::Vector2d cl = centroid(img.left), cr = centroid(img.right);
+  const Eigen::Vector2d cl = bright_centroid(img.left), cr = bright_centroid(img.right);
   EXPECT_NEAR(cl.x(), uv.x(), 0.1);
   EXPECT_NEAR(cl.y(), uv.y(), 0.1);
   EXPECT_NEAR(cr.x(), uv_r.x(), 0.1);
@@ -331,7 +331,7 @@ SubPixelShiftError sub_pixel_shift_error(const RenderOptions& options) {
 }
 
 TEST(Render, SubPixelMotionOfOutlinesAndReflectionsKeepsItsSize) {
-  // Without anti-aliasing a 19 px disc's centroid wanders by about
+  // Without anti-aliasing a 19 px disc's bright_centroid wanders by about
   // sqrt(60 edge px) * 0.29 px * 7 px / 283 px^2 = 0.06 px about its true
   // position: the floor of this measurement. With the shipped defaults the
   // mirror image moves at its true size to the same floor as the disc.

@@ -9,11 +9,12 @@
 
 #include "core/error.hpp"
 #include "sim/waves/wave_field.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using driftlab::test::kPi;
 
 TEST(ElfouhailySpectrum, DispersionHasTheCapillaryGravityMinimumPhaseSpeed) {
   // c(k) = omega / k is least at k_m = 370 rad/m, c_m = sqrt(2 g / k_m) = 0.230 m/s.

@@ -32,8 +32,8 @@ namespace {
 using test::slurp;
 
 namespace fs = std::filesystem;
-constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kG = 9.80665;
+using driftlab::test::kDeg;
+constexpr double kSensorsG = 9.80665;
 
 // Reads `text` as the `sensors` section; returns "" or the UserError message.
 std::string read_error(const std::string& text, SensorOptions* out = nullptr) {
@@ -82,8 +82,8 @@ TEST(SensorOptions, ImuPresetSetsTheNoiseFieldsAndLaterKeysOverride) {
   EXPECT_EQ(yaml::to_yaml(ImuOptions{}),
             yaml::to_yaml(ImuOptions::preset_defaults(ImuPreset::kMpu9250)));
   const ImuOptions mpu;
-  EXPECT_DOUBLE_EQ(mpu.gyro_noise_density_rad_s_sqrt_hz, 0.01 * kDeg);  // datasheet
-  EXPECT_DOUBLE_EQ(mpu.accel_noise_density_m_s2_sqrt_hz, 300e-6 * kG);  // datasheet
+  EXPECT_DOUBLE_EQ(mpu.gyro_noise_density_rad_s_sqrt_hz, 0.01 * kDeg);         // datasheet
+  EXPECT_DOUBLE_EQ(mpu.accel_noise_density_m_s2_sqrt_hz, 300e-6 * kSensorsG);  // datasheet
   SensorOptions o;
   ASSERT_EQ(read_error("imu: {preset: adis16448, rate_hz: 200}\n", &o), "");
   EXPECT_DOUBLE_EQ(o.imu.gyro_noise_density_rad_s_sqrt_hz, 1.6968e-4);  // EuRoC sensor.yaml
@@ -200,15 +200,15 @@ TEST(ImuErrors, TurnOnBiasScaleAndMisalignmentAreFixedAndApplied) {
 TEST(ImuErrors, OutputsSaturateAtTheRange) {
   ImuOptions o = ImuOptions::preset_defaults(ImuPreset::kIdeal);
   o.gyro_range_rad_s = 1.0;
-  o.accel_range_m_s2 = 2 * kG;
+  o.accel_range_m_s2 = 2 * kSensorsG;
   ImuSimulator imu(o, RngStreams(1));
   BodySample b;
   b.state.w_B = Vec3(3.0, -0.5, -7.0);
   b.v_dot_B = Vec3(40.0, 0.0, 0.0);  // 4 g surge (a slam)
   const auto s = imu.measure(b);
   EXPECT_EQ(s->gyro_rad_s, Vec3(1.0, -0.5, -1.0));
-  EXPECT_EQ(s->accel_m_s2.x(), 2 * kG);
-  EXPECT_NEAR(s->accel_m_s2.z(), -kG, 1e-12);
+  EXPECT_EQ(s->accel_m_s2.x(), 2 * kSensorsG);
+  EXPECT_NEAR(s->accel_m_s2.z(), -kSensorsG, 1e-12);
 }
 
 TEST(ImuErrors, EachNoiseSourceHasItsOwnStream) {

@@ -9,11 +9,12 @@
 #include "sim/vessel/guidance.hpp"
 #include "sim/vessel/simulator.hpp"
 #include "sim/waves/wave_field.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using driftlab::test::kPi;
 
 struct SimRun {
   std::vector<BodySample> samples;

@@ -15,14 +15,15 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "core/yaml_io.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kG = kGravity_m_s2;
+using driftlab::test::kPi;
+constexpr double kWavesG = kGravity_m_s2;
 constexpr double kRho = kWaterDensity_kg_m3;
-constexpr double kEps = std::numeric_limits<double>::epsilon();
+using driftlab::test::kEps;
 // Relative tolerance of values that only rounding separates (tens of
 // operations, each within eps / 2).
 constexpr double kRoundingTol = 1e3 * kEps;
@@ -38,10 +39,10 @@ Rng phases_rng(std::uint64_t seed) { return RngStreams(seed).stream("waves.phase
 double bisect_wavenumber(double omega, double depth) {
   double lo = 0.0;
   double hi = 1.0;
-  while (kG * hi * std::tanh(hi * depth) < omega * omega) hi *= 2.0;
+  while (kWavesG * hi * std::tanh(hi * depth) < omega * omega) hi *= 2.0;
   for (int i = 0; i < 200; ++i) {
     const double mid = 0.5 * (lo + hi);
-    (kG * mid * std::tanh(mid * depth) < omega * omega ? lo : hi) = mid;
+    (kWavesG * mid * std::tanh(mid * depth) < omega * omega ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }
@@ -104,11 +105,12 @@ TEST(Dispersion, MatchesDeepAndShallowWaterLimits) {
   // Deep water (kh >> 1): omega^2 = g k. Shallow (kh << 1): omega = k sqrt(g h) (1 - (kh)^2 / 6).
   for (const double k : {0.1, 1.0, 30.0}) {
     const double h = 60.0 / k;
-    EXPECT_NEAR(dispersion_omega(k, h), std::sqrt(kG * k), kRoundingTol * std::sqrt(kG * k));
+    EXPECT_NEAR(dispersion_omega(k, h), std::sqrt(kWavesG * k),
+                kRoundingTol * std::sqrt(kWavesG * k));
   }
   for (const double h : {0.1, 1.0, 10.0}) {
     const double k = 1e-4 / h;
-    const double shallow = k * std::sqrt(kG * h);
+    const double shallow = k * std::sqrt(kWavesG * h);
     EXPECT_NEAR(dispersion_omega(k, h), shallow, 1e-8 * shallow);
   }
   EXPECT_EQ(dispersion_omega(0.0, 1.0), 0.0);
@@ -126,7 +128,7 @@ TEST(Dispersion, WavenumberMatchesBisectionAndTheTable) {
   // Dalrymple's appendix): h / L0 = 0.1 gives h / L = 0.1410, with
   // L0 = g T^2 / (2 pi) the deep-water wavelength.
   const double h = 3.0;
-  const double period = std::sqrt(2.0 * kPi * h / (0.1 * kG));
+  const double period = std::sqrt(2.0 * kPi * h / (0.1 * kWavesG));
   const double wavelength = 2.0 * kPi / dispersion_wavenumber(2.0 * kPi / period, h);
   EXPECT_NEAR(h / wavelength, 0.1410, 5e-5);
 }
@@ -232,8 +234,8 @@ TEST(LinearWaves, DynamicPressureAtStillWaterIsRhoGEta) {
   const auto field = field_of(three_components());
   for (const Vec3& p : kUnderwaterPoints) {
     const double eta = field->elevation(p.x(), p.y(), kT);
-    EXPECT_NEAR(field->dynamic_pressure({p.x(), p.y(), 0.0}, kT), kRho * kG * eta,
-                kRoundingTol * kRho * kG * 0.17);
+    EXPECT_NEAR(field->dynamic_pressure({p.x(), p.y(), 0.0}, kT), kRho * kWavesG * eta,
+                kRoundingTol * kRho * kWavesG * 0.17);
   }
 }
 
@@ -244,8 +246,8 @@ TEST(LinearWaves, TotalPressureVanishesAtACrest) {
   const double eta = field->elevation(0.0, 0.0, 0.0);
   ASSERT_DOUBLE_EQ(eta, 0.05);
   const Vec3 surface{0.0, 0.0, -eta};
-  EXPECT_NEAR(kRho * kG * surface.z() + field->dynamic_pressure(surface, 0.0), 0.0,
-              kRoundingTol * kRho * kG * eta);
+  EXPECT_NEAR(kRho * kWavesG * surface.z() + field->dynamic_pressure(surface, 0.0), 0.0,
+              kRoundingTol * kRho * kWavesG * eta);
   // Further up, still the still-water value (no growth above z = 0).
   EXPECT_EQ(field->dynamic_pressure({0.0, 0.0, -1.0}, 0.0),
             field->dynamic_pressure({0.0, 0.0, 0.0}, 0.0));
@@ -257,7 +259,7 @@ TEST(LinearWaves, DeepWaterMotionDecaysAsExpOfMinusKDepth) {
   const auto field = field_of(airy(0.005, 0.21, 0.0, 0.6));
   const double k = 2.0 * kPi / 0.21;
   const double u0 = field->velocity({0.0, 0.0, 0.0}, 0.0).x();  // theta = 0: all horizontal
-  const double omega = std::sqrt(kG * k);
+  const double omega = std::sqrt(kWavesG * k);
   EXPECT_NEAR(u0, omega * 0.005, 1e-12 * u0);    // deep water: u = a omega at the surface
   const double t_quarter = (kPi / 2.0) / omega;  // theta = -pi/2: all vertical
   const double w0 = field->velocity({0.0, 0.0, 0.0}, t_quarter).z();
@@ -274,8 +276,8 @@ TEST(LinearWaves, ShallowWaterMotionMatchesTheLongWaveLimit) {
   const auto field = field_of(airy(0.01, 1000.0, 0.0, h));  // kh = 0.0063
   const double eta = field->elevation(0.0, 0.0, 0.0);
   for (const double z : {0.0, 0.5, 1.0})
-    EXPECT_NEAR(field->velocity({0.0, 0.0, z}, 0.0).x(), eta * std::sqrt(kG / h),
-                1e-4 * eta * std::sqrt(kG / h));
+    EXPECT_NEAR(field->velocity({0.0, 0.0, z}, 0.0).x(), eta * std::sqrt(kWavesG / h),
+                1e-4 * eta * std::sqrt(kWavesG / h));
   const double omega = field->components()[0].omega_rad_s;
   const double tq = (kPi / 2.0) / omega;
   const double w_surface = field->velocity({0.0, 0.0, 0.0}, tq).z();
@@ -304,7 +306,8 @@ TEST(LinearWaves, ShortWavesInDeepWaterStayFinite) {
     const Vec3 a = field->acceleration({0.0, 0.0, z}, 0.0);
     const double p = field->dynamic_pressure({0.0, 0.0, z}, 0.0);
     ASSERT_TRUE(v.allFinite() && a.allFinite() && std::isfinite(p)) << z;
-    EXPECT_NEAR(p, kRho * kG * 0.0001 * std::exp(-k * z), 1e-12 * kRho * kG * 0.0001) << z;
+    EXPECT_NEAR(p, kRho * kWavesG * 0.0001 * std::exp(-k * z), 1e-12 * kRho * kWavesG * 0.0001)
+        << z;
   }
 }
 

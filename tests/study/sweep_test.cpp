@@ -500,36 +500,14 @@ TEST(SweepMerge, RunMetricsIncludeTheBasinTableAndFilterStatisticsAndMissingIsMi
 // ---------------------------------------------------------------------------
 // Through the CLI: runs, resume, merge.
 
-struct Result {
-  int exit_code;
-  std::string out, err;
-};
+using Result = test::CommandResult;
+using test::run_cli;
 
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-Result run_cli(const std::vector<std::string>& args) {
-  const fs::path base =
-      fs::temp_directory_path() / ("driftlab_sweep_cli_" + std::to_string(::getpid()));
-  std::string cmd = quote(kCli.string());
-  for (const auto& a : args) cmd += " " + quote(a);
-  cmd += " > " + quote(base.string() + ".out") + " 2> " + quote(base.string() + ".err");
-  const int status = std::system(cmd.c_str());
-  Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(base.string() + ".out"),
-           slurp(base.string() + ".err")};
-  fs::remove(base.string() + ".out");
-  fs::remove(base.string() + ".err");
-  return r;
-}
-
-const std::vector<std::string> kSummaryFiles = {"sections.csv", "runs.csv", "points.csv",
-                                                "metrics.json", "summary.md"};
+const std::vector<std::string> kSweepSummaryFiles = {"sections.csv", "runs.csv", "points.csv",
+                                                     "metrics.json", "summary.md"};
 
 void expect_same_summary(const fs::path& a, const fs::path& b) {
-  for (const auto& f : kSummaryFiles) {
+  for (const auto& f : kSweepSummaryFiles) {
     const std::string x = slurp(a / "summary" / f), y = slurp(b / "summary" / f);
     EXPECT_FALSE(x.empty()) << a / "summary" / f;
     EXPECT_TRUE(x == y) << f << " differs between " << a << " and " << b;

@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -53,6 +54,11 @@ std::string user_error_of(const std::function<void()>& f) {
     return e.what();
   }
   return "(no UserError)";
+}
+
+void expect_user_error(const std::function<void()>& f, const std::string& part) {
+  const std::string msg = user_error_of(f);
+  EXPECT_NE(msg.find(part), std::string::npos) << "message: " << msg << "\nexpected part: " << part;
 }
 
 std::string shell_quote(const std::string& text) {

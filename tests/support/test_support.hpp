@@ -4,10 +4,18 @@
 
 #include <filesystem>
 #include <functional>
+#include <limits>
+#include <numbers>
 #include <string>
 #include <vector>
 
 namespace driftlab::test {
+
+/// Constants that many test files use (brought in with `using test::kPi;` and so on, so that the
+/// files of one test executable can be compiled as one unit).
+inline constexpr double kPi = std::numbers::pi;
+inline constexpr double kDeg = std::numbers::pi / 180.0;  ///< one degree [rad]
+inline constexpr double kEps = std::numeric_limits<double>::epsilon();
 
 /// The source tree (scenarios, tests/data) and the build tree (bin/driftlab).
 std::filesystem::path source_dir();
@@ -23,6 +31,8 @@ std::vector<std::string> expected_messages(const std::filesystem::path& file);
 
 /// What the UserError thrown by `f` says, or "(no UserError)" when it throws none.
 std::string user_error_of(const std::function<void()>& f);
+/// Expects `f` to throw a UserError whose message contains `part`.
+void expect_user_error(const std::function<void()>& f, const std::string& part);
 
 /// A path under the temporary folder, unique to this process and `name`, that does not exist.
 std::filesystem::path unused_temp_path(const std::string& name);

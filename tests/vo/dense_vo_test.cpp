@@ -21,6 +21,7 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "core/yaml_io.hpp"
+#include "tests/support/test_support.hpp"
 #include "tests/vo/determinism.hpp"
 #include "tests/vo/vo_test_sequences.hpp"
 #include "vo/dense/disparity.hpp"
@@ -34,24 +35,24 @@ using test::motion_error;
 using test::Sequence;
 using Vec2 = Eigen::Vector2d;
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using driftlab::test::kDeg;
 // The shared suite's per-frame targets at 0.5 m/frame.
 constexpr double kTranslationTargetM = 5e-3;
 constexpr double kRotationTargetRad = 0.02 * kDeg;
 
 Rng vo_rng() { return RngStreams(2015).stream("vo.dense"); }
 
-const Sequence& straight_640() {
+const Sequence& dense_straight_640() {
   static const Sequence s = make_sequence(test::river_bank_scene_640(), test::rig_640x480(),
                                           test::straight_poses(5, 0.5));
   return s;
 }
-const Sequence& turn_640() {
+const Sequence& dense_turn_640() {
   static const Sequence s = make_sequence(test::river_bank_scene_640(), test::rig_640x480(),
                                           test::turning_poses(5, 0.5, 2.0));
   return s;
 }
-const Sequence& straight_kitti() {
+const Sequence& dense_straight_kitti() {
   static const Sequence s = make_sequence(test::river_bank_scene_kitti(), test::kitti_rig(),
                                           test::straight_poses(4, 0.5));
   return s;
@@ -283,7 +284,7 @@ TEST(DenseDisparityTest, RefinementRemovesTheBiasOfSgbm) {
   // Lucas-Kanade refinement must bring every depth band's bias under 0.05 px, both after SGBM on
   // the full pair and after SGBM on the pair shrunk 2x (the dense VO's default), whose raw
   // disparities are only as fine as the shrunk pixels.
-  const Sequence& seq = straight_640();
+  const Sequence& seq = dense_straight_640();
   const cv::Mat truth = true_disparity(test::river_bank_scene_640(), seq.rig, seq.T_scene_cam[1]);
   cv::Mat left_f;
   seq.frames[1].left.convertTo(left_f, CV_32F);
@@ -337,7 +338,7 @@ TEST(DenseDisparityTest, RefinementRemovesTheBiasOfSgbm) {
 TEST(DenseDisparityTest, RefinementDropsMatchesTheRightImageDoesNotConfirm) {
   // A right image of noise (a faulty camera): SGBM on the shrunk pair still matches about a
   // tenth of the pixels; the residual check leaves (almost) none of them.
-  const Sequence& seq = straight_640();
+  const Sequence& seq = dense_straight_640();
   cv::Mat left_f, noise(seq.rig.camera.height, seq.rig.camera.width, CV_8UC1);
   seq.frames[1].left.convertTo(left_f, CV_32F);
   cv::randu(noise, 0, 256);
@@ -363,7 +364,7 @@ TEST(DenseDisparityTest, RefinementDropsMatchesTheRightImageDoesNotConfirm) {
 // Accuracy: the pyramid, the paper's method and the extensions
 
 TEST(DenseVoTest, PyramidConvergesAtHalfMetrePerFrameKittiWhereSingleLevelDoesNot) {
-  const Sequence& seq = straight_kitti();
+  const Sequence& seq = dense_straight_kitti();
   const Worst pyramid = run(seq, DenseVoOptions{}, "KITTI 0.5 m/frame, 4 levels");
   EXPECT_EQ(pyramid.invalid, 0);
   EXPECT_LT(pyramid.t_m, kTranslationTargetM);
@@ -400,7 +401,7 @@ TEST(DenseVoTest, PyramidConvergesAtOneAndAHalfMetresPerFrameWhereSingleLevelCan
 TEST(DenseVoTest, PaperMethodIsSelectableAndTheExtensionsAreMoreAccurate) {
   // The paper's method is limited by SGBM's disparity bias (DenseDisparityTest); the extended
   // method's refinement removes most of it.
-  for (const Sequence* seq : {&straight_640(), &turn_640()}) {
+  for (const Sequence* seq : {&dense_straight_640(), &dense_turn_640()}) {
     const Worst paper = run(*seq, DenseVoOptions::paper(), "640x480, paper");
     const Worst extended = run(*seq, DenseVoOptions{}, "640x480, extended");
     EXPECT_EQ(paper.invalid, 0);
@@ -432,7 +433,7 @@ StereoFrame with_occluder(const StereoFrame& f, std::uint64_t seed) {
 }
 
 TEST(DenseVoTest, RobustWeightsHelpWithAnOccludingPatch) {
-  const Sequence& seq = turn_640();
+  const Sequence& seq = dense_turn_640();
   DenseVoOptions least_squares;
   least_squares.robust_weights = false;
   auto worst = [&](const DenseVoOptions& o, const char* label) {
@@ -483,7 +484,7 @@ TEST(DenseVoTest, GradientMaskKeepsRipplingWaterOutOfTheAlignment) {
 }
 
 TEST(DenseVoTest, LowerImageMaskDropsTheLowerRows) {
-  const Sequence& seq = straight_640();
+  const Sequence& seq = dense_straight_640();
   DenseVoOptions o;
   o.mask_lower_fraction = 0.4;
   DenseStereoOdometry full(seq.rig, DenseVoOptions{}, vo_rng());
@@ -547,7 +548,7 @@ TEST(DenseVoTest, StatisticsReportTheCovariates) {
   // f: pixels with a valid depth, against the pixels that truly have one (disparity >= 1 px)
   // in the columns SGBM searches; d: mean depth of the used pixels, against the true mean
   // depth of those pixels in the current frame.
-  const Sequence& seq = straight_640();
+  const Sequence& seq = dense_straight_640();
   DenseStereoOdometry vo(seq.rig, DenseVoOptions{}, vo_rng());
   const VoResult first = vo.process(seq.frames[0]);
   EXPECT_EQ(first.valid_depth_pixels, 0);  // no motion estimated, no depth map used
@@ -676,7 +677,7 @@ TEST(DenseVoOptionsTest, YamlRoundTripAndStrictKeys) {
 }
 
 TEST(DenseVoTest, RejectsABadReferenceOrTargetWithAReason) {
-  const Sequence& seq = straight_640();
+  const Sequence& seq = dense_straight_640();
   DenseStereoOdometry vo(seq.rig, DenseVoOptions{}, vo_rng());
   vo.process(seq.frames[0]);
   // Current frame: the previous left image, its right image replaced by noise. The left images
@@ -700,7 +701,7 @@ TEST(DenseVoTest, RejectsABadReferenceOrTargetWithAReason) {
 // serial order of the paper's two steps, must give the same bytes: threading may not change a
 // result. The turning sequence with the shipped options (constant-velocity prior included).
 TEST(DenseVoTest, ThreadedFrameMatchesTheComponentsRunInTurn) {
-  const Sequence& seq = turn_640();
+  const Sequence& seq = dense_turn_640();
   const DenseVoOptions o;
   DenseStereoOdometry vo(seq.rig, o, vo_rng());
   dense::DisparityEstimator stereo(dense::disparity_options(o));
@@ -756,7 +757,7 @@ TEST(DenseVoTest, ThreadedFrameMatchesTheComponentsRunInTurn) {
 }
 
 TEST(DenseVoTest, DeterministicAcrossInstancesResetAndOpenCvThreadCounts) {
-  const Sequence& seq = turn_640();
+  const Sequence& seq = dense_turn_640();
   auto run_bytes = [&](DenseStereoOdometry& vo) {
     std::vector<double> bytes;
     for (const StereoFrame& f : seq.frames) {

@@ -16,6 +16,7 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "core/yaml_io.hpp"
+#include "tests/support/test_support.hpp"
 #include "tests/vo/vo_test_sequences.hpp"
 #include "vo/pnp/pnp_features.hpp"
 #include "vo/pnp/pnp_subpixel.hpp"
@@ -27,30 +28,30 @@ using test::make_sequence;
 using test::motion_error;
 using test::Sequence;
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using driftlab::test::kDeg;
 // The sparse VO's per-frame targets at 0.5 m/frame; the PnP VO is held to the same.
-constexpr double kTranslationTargetM = 0.005;
-constexpr double kRotationTargetRad = 0.02 * kDeg;
+constexpr double kPnpTranslationTargetM = 0.005;
+constexpr double kPnpRotationTargetRad = 0.02 * kDeg;
 // Identical frames give identical features and alignments: the only error left is the
 // Levenberg-Marquardt stopping point, far below a micrometre.
-constexpr double kZeroMotionTolM = 1e-6;
+constexpr double kPnpZeroMotionTolM = 1e-6;
 constexpr double kZeroMotionTolRad = 1e-7;
 constexpr std::uint64_t kSeed = 20200917;
 
-Rng vo_rng() { return RngStreams(kSeed).stream("vo.pnp"); }
+Rng pnp_vo_rng() { return RngStreams(kSeed).stream("vo.pnp"); }
 
 // Sequences are rendered once per test program: they are pure functions of their poses.
-const Sequence& straight_640() {
+const Sequence& pnp_straight_640() {
   static const Sequence s = make_sequence(test::river_bank_scene_640(), test::rig_640x480(),
                                           test::straight_poses(6, 0.5));
   return s;
 }
-const Sequence& straight_kitti() {
+const Sequence& pnp_straight_kitti() {
   static const Sequence s = make_sequence(test::river_bank_scene_kitti(), test::kitti_rig(),
                                           test::straight_poses(5, 0.5));
   return s;
 }
-const Sequence& turn_640() {
+const Sequence& pnp_turn_640() {
   static const Sequence s = make_sequence(test::river_bank_scene_640(), test::rig_640x480(),
                                           test::turning_poses(6, 0.5, 2.0));
   return s;
@@ -64,7 +65,7 @@ struct ErrorSummary {
 // Runs a VO over a sequence, checks every frame after the first is valid and within the
 // targets, and prints what it achieved (the numbers docs/vo-and-filters.md quotes).
 ErrorSummary run_and_check(const Sequence& seq, const PnpVoOptions& options, const char* label) {
-  PnpStereoOdometry vo(seq.rig, options, vo_rng());
+  PnpStereoOdometry vo(seq.rig, options, pnp_vo_rng());
   ErrorSummary e;
   for (std::size_t k = 0; k < seq.frames.size(); ++k) {
     const VoResult r = vo.process(seq.frames[k]);
@@ -76,8 +77,8 @@ ErrorSummary run_and_check(const Sequence& seq, const PnpVoOptions& options, con
     EXPECT_TRUE(r.valid) << label << " frame " << k << ": " << r.brief();
     if (!r.valid) continue;
     const auto err = motion_error(r.T_prev_curr, seq.T_prev_curr(k));
-    EXPECT_LT(err.translation_m, kTranslationTargetM) << label << " frame " << k;
-    EXPECT_LT(err.rotation_rad, kRotationTargetRad) << label << " frame " << k;
+    EXPECT_LT(err.translation_m, kPnpTranslationTargetM) << label << " frame " << k;
+    EXPECT_LT(err.rotation_rad, kPnpRotationTargetRad) << label << " frame " << k;
     EXPECT_GE(r.inliers, options.min_inliers);
     EXPECT_LE(r.inliers, r.matches);
     EXPECT_GT(r.mean_inlier_depth_m, 1.0);
@@ -114,7 +115,7 @@ void expect_invalid_identity(const VoResult& r, const std::string& reason_part) 
   EXPECT_TRUE(std::isfinite(r.mean_inlier_depth_m));
 }
 
-StereoFrame uniform_frame(const StereoRig& rig, std::uint8_t grey, TimeNs t) {
+StereoFrame pnp_uniform_frame(const StereoRig& rig, std::uint8_t grey, TimeNs t) {
   StereoFrame f;
   f.t_ns = t;
   f.left = cv::Mat(rig.camera.height, rig.camera.width, CV_8UC1, cv::Scalar(grey));
@@ -126,25 +127,25 @@ StereoFrame uniform_frame(const StereoRig& rig, std::uint8_t grey, TimeNs t) {
 // Accuracy
 
 TEST(PnpVoTest, StraightHalfMetrePerFrameWithinSparseTargets640x480) {
-  run_and_check(straight_640(), PnpVoOptions{}, "640x480 straight 0.5 m/frame");
+  run_and_check(pnp_straight_640(), PnpVoOptions{}, "640x480 straight 0.5 m/frame");
 }
 
 TEST(PnpVoTest, StraightHalfMetrePerFrameWithinSparseTargetsKitti) {
-  run_and_check(straight_kitti(), PnpVoOptions{}, "1241x376 straight 0.5 m/frame");
+  run_and_check(pnp_straight_kitti(), PnpVoOptions{}, "1241x376 straight 0.5 m/frame");
 }
 
 TEST(PnpVoTest, TracksTwoDegreePerFrameYawTurn) {
-  const Sequence& seq = turn_640();
+  const Sequence& seq = pnp_turn_640();
   run_and_check(seq, PnpVoOptions{}, "640x480 turn 2 deg/frame");
   // The yaw itself, about the camera's y axis (the rotation error above already bounds it).
-  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, vo_rng());
+  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, pnp_vo_rng());
   vo.process(seq.frames[0]);
   const VoResult r = vo.process(seq.frames[1]);
   ASSERT_TRUE(r.valid) << r.brief();
   const Vec3 phi = so3_log(r.T_prev_curr.quaternion());
-  EXPECT_NEAR(phi.y(), 2.0 * kDeg, kRotationTargetRad);
-  EXPECT_NEAR(phi.x(), 0.0, kRotationTargetRad);
-  EXPECT_NEAR(phi.z(), 0.0, kRotationTargetRad);
+  EXPECT_NEAR(phi.y(), 2.0 * kDeg, kPnpRotationTargetRad);
+  EXPECT_NEAR(phi.x(), 0.0, kPnpRotationTargetRad);
+  EXPECT_NEAR(phi.z(), 0.0, kPnpRotationTargetRad);
 }
 
 TEST(PnpVoTest, BriskDescriptorTracksWithinTwiceTheTargets) {
@@ -153,26 +154,26 @@ TEST(PnpVoTest, BriskDescriptorTracksWithinTwiceTheTargets) {
   // 0.007 deg); it is the alternative, not the paper's choice.
   PnpVoOptions o;
   o.descriptor = PnpDescriptor::kBrisk;
-  const Sequence& seq = straight_640();
-  PnpStereoOdometry vo(seq.rig, o, vo_rng());
+  const Sequence& seq = pnp_straight_640();
+  PnpStereoOdometry vo(seq.rig, o, pnp_vo_rng());
   vo.process(seq.frames[0]);
   for (std::size_t k = 1; k < seq.frames.size(); ++k) {
     const VoResult r = vo.process(seq.frames[k]);
     ASSERT_TRUE(r.valid) << r.brief();
     const auto err = motion_error(r.T_prev_curr, seq.T_prev_curr(k));
-    EXPECT_LT(err.translation_m, 2.0 * kTranslationTargetM) << "frame " << k;
-    EXPECT_LT(err.rotation_rad, 2.0 * kRotationTargetRad) << "frame " << k;
+    EXPECT_LT(err.translation_m, 2.0 * kPnpTranslationTargetM) << "frame " << k;
+    EXPECT_LT(err.rotation_rad, 2.0 * kPnpRotationTargetRad) << "frame " << k;
   }
 }
 
 TEST(PnpVoTest, ZeroMotionGivesIdentity) {
-  const Sequence& seq = straight_640();
-  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, vo_rng());
+  const Sequence& seq = pnp_straight_640();
+  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, pnp_vo_rng());
   vo.process(seq.frames[2]);
   for (int i = 0; i < 3; ++i) {
     const VoResult r = vo.process(seq.frames[2]);
     ASSERT_TRUE(r.valid) << r.brief();
-    EXPECT_TRUE(r.T_prev_curr.is_approx(SE3(), kZeroMotionTolM, kZeroMotionTolRad))
+    EXPECT_TRUE(r.T_prev_curr.is_approx(SE3(), kPnpZeroMotionTolM, kZeroMotionTolRad))
         << r.T_prev_curr.translation().transpose();
     EXPECT_EQ(r.inliers, r.matches);  // every match reprojects exactly
   }
@@ -180,25 +181,25 @@ TEST(PnpVoTest, ZeroMotionGivesIdentity) {
 
 TEST(PnpVoTest, AccumulatedPoseFollowsGroundTruth) {
   // Eq. (3) over the turn: drift stays within the sum of the per-frame targets.
-  const Sequence& seq = turn_640();
-  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, vo_rng());
+  const Sequence& seq = pnp_turn_640();
+  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, pnp_vo_rng());
   SE3 T_first_cam;
   for (const StereoFrame& f : seq.frames) T_first_cam = accumulate_pose(T_first_cam, vo.process(f));
   const SE3 truth = seq.T_scene_cam.front().inverse() * seq.T_scene_cam.back();
   const double frames = static_cast<double>(seq.frames.size() - 1);
   // Rotation errors also swing the later translations: 2.5 m travelled x target angle.
   EXPECT_LT((T_first_cam.translation() - truth.translation()).norm(),
-            frames * kTranslationTargetM + 2.5 * frames * kRotationTargetRad);
+            frames * kPnpTranslationTargetM + 2.5 * frames * kPnpRotationTargetRad);
   EXPECT_LT(angle_between(T_first_cam.quaternion(), truth.quaternion()),
-            frames * kRotationTargetRad);
+            frames * kPnpRotationTargetRad);
 }
 
 // ---------------------------------------------------------------------------------------------
 // Policies of VoResult
 
 TEST(PnpVoTest, FirstFrameIsInvalidIdentityAndResetRepeatsIt) {
-  const Sequence& seq = straight_640();
-  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, vo_rng());
+  const Sequence& seq = pnp_straight_640();
+  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, pnp_vo_rng());
   expect_invalid_identity(vo.process(seq.frames[0]), "first frame");
   EXPECT_TRUE(vo.process(seq.frames[1]).valid);
   vo.reset();
@@ -207,25 +208,26 @@ TEST(PnpVoTest, FirstFrameIsInvalidIdentityAndResetRepeatsIt) {
 }
 
 TEST(PnpVoTest, BlackFramesAreInvalidWithReasonAndTrackingRecovers) {
-  const Sequence& seq = straight_640();
-  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, vo_rng());
+  const Sequence& seq = pnp_straight_640();
+  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, pnp_vo_rng());
   vo.process(seq.frames[0]);
-  const VoResult black = vo.process(uniform_frame(seq.rig, 0, 1));
+  const VoResult black = vo.process(pnp_uniform_frame(seq.rig, 0, 1));
   expect_invalid_identity(black, "too few features");
   EXPECT_EQ(vo.last_stats().left_features, 0);
   // The VO advanced to the black frame: the next one has no previous points to move from.
   expect_invalid_identity(vo.process(seq.frames[2]), "too few stereo points in the previous frame");
   const VoResult back = vo.process(seq.frames[3]);
   ASSERT_TRUE(back.valid) << back.brief();
-  EXPECT_LT(motion_error(back.T_prev_curr, seq.T_prev_curr(3)).translation_m, kTranslationTargetM);
+  EXPECT_LT(motion_error(back.T_prev_curr, seq.T_prev_curr(3)).translation_m,
+            kPnpTranslationTargetM);
 }
 
 TEST(PnpVoTest, FlatFramesAreInvalidWithReason) {
   const StereoRig rig = test::rig_640x480();
-  PnpStereoOdometry vo(rig, PnpVoOptions{}, vo_rng());
-  expect_invalid_identity(vo.process(uniform_frame(rig, 128, 0)), "first frame");
+  PnpStereoOdometry vo(rig, PnpVoOptions{}, pnp_vo_rng());
+  expect_invalid_identity(vo.process(pnp_uniform_frame(rig, 128, 0)), "first frame");
   for (int k = 1; k < 3; ++k) {
-    const VoResult r = vo.process(uniform_frame(rig, 128, k));
+    const VoResult r = vo.process(pnp_uniform_frame(rig, 128, k));
     expect_invalid_identity(r, "too few features");
     EXPECT_EQ(r.matches, 0);
     EXPECT_EQ(r.inliers, 0);
@@ -236,7 +238,7 @@ TEST(PnpVoTest, WaterOnlyFramesAreInvalid) {
   // Slow ripples only: GFTT's relative quality level alone would pick corners on them; the
   // absolute floor (min_corner_response) does not.
   const StereoRig rig = test::rig_640x480();
-  PnpStereoOdometry vo(rig, PnpVoOptions{}, vo_rng());
+  PnpStereoOdometry vo(rig, PnpVoOptions{}, pnp_vo_rng());
   for (int k = 0; k < 3; ++k) {
     const VoResult r = vo.process(test::render_stereo(
         test::water_scene(0.7 * k), rig, SE3::from_translation(Vec3(0, 0, 0.1 * k)), k));
@@ -247,8 +249,8 @@ TEST(PnpVoTest, WaterOnlyFramesAreInvalid) {
 }
 
 TEST(PnpVoTest, WrongImageSizeOrTypeThrows) {
-  const Sequence& seq = straight_640();
-  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, vo_rng());
+  const Sequence& seq = pnp_straight_640();
+  PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, pnp_vo_rng());
   StereoFrame f = seq.frames[0];
   f.right = f.right(cv::Rect(0, 0, 320, 240)).clone();
   EXPECT_THROW(vo.process(f), UserError);
@@ -258,14 +260,14 @@ TEST(PnpVoTest, WrongImageSizeOrTypeThrows) {
 }
 
 TEST(PnpVoTest, DeterministicSameInputSameBytes) {
-  const Sequence& seq = turn_640();
+  const Sequence& seq = pnp_turn_640();
   auto run = [&](PnpStereoOdometry& vo) {
     std::vector<VoResult> out;
     for (const StereoFrame& f : seq.frames) out.push_back(vo.process(f));
     return out;
   };
-  PnpStereoOdometry a(seq.rig, PnpVoOptions{}, vo_rng());
-  PnpStereoOdometry b(seq.rig, PnpVoOptions{}, vo_rng());
+  PnpStereoOdometry a(seq.rig, PnpVoOptions{}, pnp_vo_rng());
+  PnpStereoOdometry b(seq.rig, PnpVoOptions{}, pnp_vo_rng());
   const auto ra = run(a);
   const auto rb = run(b);
   a.reset();
@@ -311,9 +313,9 @@ Sequence lower_third_only(const Sequence& seq) {
 }
 
 TEST(PnpVoTest, CropIgnoresLowerThird) {
-  const Sequence seq = lower_third_only(straight_640());
+  const Sequence seq = lower_third_only(pnp_straight_640());
   {
-    PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, vo_rng());
+    PnpStereoOdometry vo(seq.rig, PnpVoOptions{}, pnp_vo_rng());
     EXPECT_EQ(vo.crop_rows(), 320);
     vo.process(seq.frames[0]);
     const VoResult r = vo.process(seq.frames[1]);
@@ -325,7 +327,7 @@ TEST(PnpVoTest, CropIgnoresLowerThird) {
     // Without the crop the same frames are textured enough to track.
     PnpVoOptions o;
     o.crop_upper_fraction = 1.0;
-    PnpStereoOdometry vo(seq.rig, o, vo_rng());
+    PnpStereoOdometry vo(seq.rig, o, pnp_vo_rng());
     vo.process(seq.frames[0]);
     const VoResult r = vo.process(seq.frames[1]);
     EXPECT_GT(vo.last_stats().left_features, 100);
@@ -334,7 +336,7 @@ TEST(PnpVoTest, CropIgnoresLowerThird) {
 }
 
 TEST(PnpVoTest, FeaturesStayAboveTheCropLine) {
-  const Sequence& seq = straight_640();
+  const Sequence& seq = pnp_straight_640();
   const PnpVoOptions o;
   pnp::FeatureExtractor ex(o, seq.rig.camera.width, seq.rig.camera.height);
   pnp::FeatureSet f;
@@ -359,7 +361,7 @@ TEST(PnpVoOptionsTest, BadOptionsThrowNamingTheField) {
   const StereoRig rig = test::rig_640x480();
   auto message = [&](const PnpVoOptions& o) {
     try {
-      PnpStereoOdometry vo(rig, o, vo_rng());
+      PnpStereoOdometry vo(rig, o, pnp_vo_rng());
     } catch (const UserError& e) {
       return std::string(e.what());
     }
@@ -384,7 +386,7 @@ TEST(PnpVoOptionsTest, BadOptionsThrowNamingTheField) {
   EXPECT_NE(message(o).find("too small"), std::string::npos) << message(o);
   StereoRig bad_rig = rig;
   bad_rig.baseline_m = 0.0;
-  EXPECT_THROW(PnpStereoOdometry(bad_rig, PnpVoOptions{}, vo_rng()), UserError);
+  EXPECT_THROW(PnpStereoOdometry(bad_rig, PnpVoOptions{}, pnp_vo_rng()), UserError);
 }
 
 TEST(PnpVoOptionsTest, YamlRoundTripAndStrictKeys) {

@@ -28,21 +28,26 @@ class FixedVo final : public StereoOdometry {
   double x_;
 };
 
-const auto error_of = driftlab::test::user_error_of;
-
 TEST(VoRegistry, RegistersByNameAndRefusesTakenOrUnsafeNames) {
   const VoFactory factory = [](const StereoRig& rig, Rng) {
     return std::make_unique<FixedVo>(rig.baseline_m);
   };
   EXPECT_EQ(make_registered_vo("fixed_test", StereoRig{}, Rng(1)), nullptr);
   register_vo("fixed_test", factory);
-  EXPECT_NE(error_of([&] { register_vo("fixed_test", factory); }).find("already registered"),
+  EXPECT_NE(driftlab::test::user_error_of([&] {
+              register_vo("fixed_test", factory);
+            }).find("already registered"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { register_vo("sparse", factory); }).find("a built-in VO's name"),
+  EXPECT_NE(driftlab::test::user_error_of([&] {
+              register_vo("sparse", factory);
+            }).find("a built-in VO's name"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { register_vo("a b", factory); }).find("letters, digits"),
-            std::string::npos);
-  EXPECT_NE(error_of([&] { register_vo("", factory); }).find("letters, digits"), std::string::npos);
+  EXPECT_NE(
+      driftlab::test::user_error_of([&] { register_vo("a b", factory); }).find("letters, digits"),
+      std::string::npos);
+  EXPECT_NE(
+      driftlab::test::user_error_of([&] { register_vo("", factory); }).find("letters, digits"),
+      std::string::npos);
   const auto names = available_vo_names();
   EXPECT_EQ(names.front(), "sparse");
   EXPECT_EQ(names.back(), "fixed_test");
@@ -91,7 +96,7 @@ TEST(VoRegistry, AVoWithOptionsGetsThemFromPipelinePluginsOrItsDefaults) {
                 .T_prev_curr.translation()
                 .x(),
             2.0);
-  EXPECT_NE(error_of([&] {
+  EXPECT_NE(driftlab::test::user_error_of([&] {
               register_vo<FixedOptions>("fixed_opts_test",
                                         [](const StereoRig&, Rng, const FixedOptions& o) {
                                           return std::make_unique<FixedVo>(o.step_m);

@@ -19,6 +19,7 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "core/yaml_io.hpp"
+#include "tests/support/test_support.hpp"
 #include "tests/vo/determinism.hpp"
 #include "tests/vo/vo_test_sequences.hpp"
 #include "vo/sparse/circle_matcher.hpp"
@@ -38,8 +39,8 @@ using sparse::ImageFeatures;
 using sparse::StereoMotionEstimator;
 using sparse::StereoPointMatch;
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
-constexpr double kDeg = std::numbers::pi / 180.0;
+using driftlab::test::kDeg;
+using driftlab::test::kEps;
 
 const test::Sequence& short_640() {
   static const test::Sequence s = test::make_sequence(

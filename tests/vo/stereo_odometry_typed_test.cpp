@@ -15,6 +15,7 @@
 
 #include "core/error.hpp"
 #include "core/rng.hpp"
+#include "tests/support/test_support.hpp"
 #include "tests/vo/vo_test_sequences.hpp"
 #include "vo/dense/dense_vo.hpp"
 #include "vo/pnp/pnp_vo.hpp"
@@ -24,7 +25,7 @@
 namespace driftlab::vo {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using driftlab::test::kDeg;
 // Acceptance of the VO issue: per frame at 0.5 m/frame.
 constexpr double kMaxTranslationErrorM = 5e-3;
 constexpr double kMaxRotationErrorRad = 0.02 * kDeg;

@@ -20,20 +20,21 @@
 namespace driftlab::vo {
 namespace {
 
-constexpr int kFrames = 11;  // 10 motions
-constexpr double kStepM = 0.5;
-constexpr double kYawDegPerFrame = 2.0;
+constexpr int kWindowFrames = 11;  // 10 motions
+constexpr double kWindowStepM = 0.5;
+constexpr double kWindowYawDegPerFrame = 2.0;
 
 const test::Sequence& straight() {
-  static const test::Sequence s = test::make_sequence(
-      test::river_bank_scene_640(), test::rig_640x480(), test::straight_poses(kFrames, kStepM));
+  static const test::Sequence s =
+      test::make_sequence(test::river_bank_scene_640(), test::rig_640x480(),
+                          test::straight_poses(kWindowFrames, kWindowStepM));
   return s;
 }
 
 const test::Sequence& yaw() {
   static const test::Sequence s =
       test::make_sequence(test::river_bank_scene_640(), test::rig_640x480(),
-                          test::turning_poses(kFrames, kStepM, kYawDegPerFrame));
+                          test::turning_poses(kWindowFrames, kWindowStepM, kWindowYawDegPerFrame));
   return s;
 }
 
@@ -118,12 +119,12 @@ void expect_no_worse(const char* name, const test::Sequence& seq) {
   std::printf(
       "[ %s ] after %d frames: frame-to-frame %.3f mm %.5f deg, "
       "window_ba %.3f mm %.5f deg\n",
-      name, kFrames - 1, 1e3 * f2f.translation_m, f2f.rotation_rad * 180 / std::numbers::pi,
+      name, kWindowFrames - 1, 1e3 * f2f.translation_m, f2f.rotation_rad * 180 / std::numbers::pi,
       1e3 * ba.translation_m, ba.rotation_rad * 180 / std::numbers::pi);
   EXPECT_TRUE(ba.all_finite);
   EXPECT_TRUE(f2f.all_finite);
-  EXPECT_EQ(ba.valid, kFrames - 1);
-  EXPECT_EQ(f2f.valid, kFrames - 1);
+  EXPECT_EQ(ba.valid, kWindowFrames - 1);
+  EXPECT_EQ(f2f.valid, kWindowFrames - 1);
   // No worse, up to 0.1 mm / 0.001 deg of slack for equal results rounded differently.
   EXPECT_LE(ba.translation_m, f2f.translation_m + 1e-4) << name;
   EXPECT_LE(ba.rotation_rad, f2f.rotation_rad + 1e-3 * std::numbers::pi / 180) << name;
@@ -144,10 +145,10 @@ TEST(WindowBaTest, YawAccumulatedErrorStaysWithinBounds) {
   const RunError ba = run(yaw(), window_ba_options());
   std::printf(
       "[ yaw ] after %d frames: frame-to-frame %.3f mm %.5f deg, window_ba %.3f mm %.5f deg\n",
-      kFrames - 1, 1e3 * f2f.translation_m, f2f.rotation_rad * 180 / std::numbers::pi,
+      kWindowFrames - 1, 1e3 * f2f.translation_m, f2f.rotation_rad * 180 / std::numbers::pi,
       1e3 * ba.translation_m, ba.rotation_rad * 180 / std::numbers::pi);
   EXPECT_TRUE(ba.all_finite);
-  EXPECT_EQ(ba.valid, kFrames - 1);
+  EXPECT_EQ(ba.valid, kWindowFrames - 1);
   EXPECT_LT(ba.translation_m, 0.010);
   EXPECT_LT(ba.rotation_rad, 0.05 * 3.141592653589793 / 180);
 }
@@ -155,7 +156,7 @@ TEST(WindowBaTest, YawAccumulatedErrorStaysWithinBounds) {
 TEST(WindowBaTest, SmallestWindowTracks) {
   const RunError ba = run(yaw(), window_ba_options(2));
   EXPECT_TRUE(ba.all_finite);
-  EXPECT_EQ(ba.valid, kFrames - 1);
+  EXPECT_EQ(ba.valid, kWindowFrames - 1);
   EXPECT_LT(ba.translation_m, 0.05);
 }
 
