@@ -166,7 +166,11 @@ struct FillProducer : Producer {
 
 }  // namespace producers
 
-using namespace producers;
+using producers::Delivered;
+using producers::FillProducer;
+using producers::Producer;
+using producers::RenderProducer;
+using producers::ReplayProducer;
 
 struct FrameSource::Impl {
   const Scenario& sc;
