@@ -44,6 +44,12 @@ std::string shipped_asset_dir() {
   return DRIFTLAB_SCENES_ASSET_DIR;  // missing: the error names it
 }
 
+std::string shipped_asset_hint() {
+  return "; driftlab's own assets are looked for in $DRIFTLAB_ASSET_DIR, "
+         "PREFIX/share/driftlab/assets beside PREFIX/bin/driftlab, and the source tree's "
+         "scenes/assets";
+}
+
 std::string shipped_asset(const std::string& file_name) {
   return (std::filesystem::path(shipped_asset_dir()) / file_name).string();
 }
@@ -51,13 +57,9 @@ std::string shipped_asset(const std::string& file_name) {
 sim::Mesh load_mesh_asset(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
-    throw UserError(fmt::format(
-        "mesh asset '{}': no such file (expected an OBJ, PLY or glTF file){}", path,
-        path.starts_with(shipped_asset_dir())
-            ? "; driftlab's own assets are looked for in $DRIFTLAB_ASSET_DIR, "
-              "PREFIX/share/driftlab/assets beside PREFIX/bin/driftlab, and the source tree's "
-              "scenes/assets"
-            : ""));
+    throw UserError(
+        fmt::format("mesh asset '{}': no such file (expected an OBJ, PLY or glTF file){}", path,
+                    path.starts_with(shipped_asset_dir()) ? shipped_asset_hint() : ""));
 
   Assimp::Importer importer;
   // Hard edges (a bollard's rim, a box corner) keep separate normals.

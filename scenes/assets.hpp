@@ -24,6 +24,9 @@ sim::Mesh load_mesh_asset(const std::string& path);
 /// installed libraries).
 std::string shipped_asset_dir();
 
+/// What an error about a missing shipped asset adds: where they are looked for.
+std::string shipped_asset_hint();
+
 /// Path of a shipped asset, e.g. shipped_asset("bollard.obj").
 std::string shipped_asset(const std::string& file_name);
 

@@ -12,6 +12,7 @@
 #include "scenes/assets.hpp"
 #include "scenes/mesh_builder.hpp"
 #include "scenes/noise.hpp"
+#include "scenes/photographs.hpp"
 #include "scenes/textures.hpp"
 
 namespace driftlab::scenes {
@@ -107,9 +108,22 @@ struct Textures {
   int grass, soil, bark, foliage, reeds, concrete, sheet, facade, roof, brick, stone;
 };
 
-Textures add_textures(sim::SceneGeometry* g, std::uint64_t seed, double contrast) {
+// The procedural textures, or where options.photographs asks for them the photographs of the
+// same kinds (scenes/photographs.hpp), each at the mean grey of the procedural texture it
+// replaces.
+Textures add_textures(sim::SceneGeometry* g, std::uint64_t seed, const RiverReachOptions& o) {
   const RngStreams streams(seed);
-  auto add = [&](TextureKind kind) { return add_scene_texture(g, streams, kind, contrast); };
+  const std::vector<PhotographEntry> photos =
+      o.photographs ? photograph_manifest() : std::vector<PhotographEntry>{};
+  auto add = [&](TextureKind kind) {
+    const int index = add_scene_texture(g, streams, kind, o.texture_contrast);
+    const bool photographed = std::any_of(photos.begin(), photos.end(), [&](const auto& e) {
+      return e.kind == texture_kind_name(kind);
+    });
+    sim::Texture& t = g->textures[static_cast<std::size_t>(index)];
+    if (photographed) t = load_photograph(kind, mean_gray(t));
+    return index;
+  };
   Textures t{};
   t.grass = add(TextureKind::kGrass);
   t.soil = add(TextureKind::kSoil);
@@ -675,7 +689,7 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
   g.lighting = outdoor_lighting(sky);
   g.water = sim::WaterAppearance{};
   g.water.turbidity = 0.6f;  // a lowland river after rain: murky, brownish-grey
-  const Textures tex = add_textures(&g, seed, options.texture_contrast);
+  const Textures tex = add_textures(&g, seed, options);
   const Bank k = bank_of(options);
   const Noise n = terrain_noise(seed);
   sim::Mesh bollard = load_mesh_asset(shipped_asset("bollard.obj"));

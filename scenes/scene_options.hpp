@@ -32,6 +32,7 @@ struct RiverReachOptions {
   double tree_height_m = 12.0;
   double vegetation_density = 0.6;
   double texture_contrast = 2.0;
+  bool photographs = true;
   bool bridge = true;
   bool quay_wall = true;
   int buildings = 4;
@@ -90,6 +91,11 @@ struct RiverReachOptions {
       "imagestats`); 1 is the "
       "textures as drawn",
       yaml::in_range(0, 4));
+    a("photographs", photographs,
+      "Photographed materials where there are photographs (grass, soil, bark, stones, bricks, "
+      "concrete: Debian's ufoai-textures, fetched by scripts/fetch-materials and credited in the "
+      "README), each scaled to the mean grey of the procedural texture it replaces; false: "
+      "procedural textures everywhere. texture_contrast applies to procedural textures only");
     a("bridge", bridge, "Road bridge with piers across each reach tile");
     a("quay_wall", quay_wall,
       "Feature-poor sheet-piled quay wall (~30 m) on the east bank of each tile");

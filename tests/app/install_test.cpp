@@ -131,8 +131,8 @@ TEST(InstalledPackage, CustomVoProjectBuildsRegistersAndRuns) {
   r = run_shell(my + " sweep merge " + shell_quote((root / "sweep").string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
 
-  // The installed driftlab reads the scene's meshes from the prefix (share/driftlab/assets),
-  // not from the source tree; DRIFTLAB_ASSET_DIR overrides both.
+  // The installed driftlab reads the scene's meshes and the photographs' manifest from the
+  // prefix (share/driftlab/assets), not from the source tree; DRIFTLAB_ASSET_DIR overrides both.
   EXPECT_TRUE(fs::exists(prefix / "share/driftlab/assets/bollard.obj"));
   const std::string installed = shell_quote((prefix / "bin/driftlab").string()) + " run " +
                                 shell_quote(scenario) +
@@ -144,7 +144,10 @@ TEST(InstalledPackage, CustomVoProjectBuildsRegistersAndRuns) {
   r = run_shell("DRIFTLAB_ASSET_DIR=" + shell_quote((root / "nowhere").string()) + " " + installed +
                 shell_quote((root / "run3").string()));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.output.find("nowhere/bollard.obj': no such file"), std::string::npos) << r.output;
+  // The first shipped asset the river reach reads: the photographs' manifest.
+  EXPECT_TRUE(fs::exists(prefix / "share/driftlab/assets/photographs.tsv"));
+  EXPECT_NE(r.output.find("nowhere/photographs.tsv': cannot be read"), std::string::npos)
+      << r.output;
   EXPECT_NE(r.output.find("$DRIFTLAB_ASSET_DIR"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(root / "run3"));
 

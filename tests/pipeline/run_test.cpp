@@ -386,11 +386,13 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   }
 
   // Accuracy on frames from the real renderer, shipped defaults (the river paper's Bumblebee2
-  // camera, textures at contrast 2, the reflection pass at full resolution). Measured on
-  // 2026-11-26 with the 1 px RANSAC inlier threshold: sparse_kf e'_p 0.0045 m/m, length +0.2 %,
-  // 3D RMSE 0.26 % of the track; sparse (the paper's frame-to-frame method) 0.0338 m/m, length
-  // -2.6 % (with libviso2's 2 px before: 0.0112 and 0.1097 m/m, sparse length -10.3 %). The
-  // bounds sit 30 % above, so a 30 % regression of either VO or of the renderer fails.
+  // camera, photographed materials and procedural textures at contrast 2, the reflection pass
+  // at full resolution). Measured on 2026-11-29 with the photographed materials: sparse_kf
+  // e'_p 0.0042 m/m, length +0.1 %, 3D RMSE 0.24 % of the track; sparse (the paper's
+  // frame-to-frame method) 0.0467 m/m, length -2.8 % (procedural textures everywhere,
+  // 2026-11-26: 0.0045 and 0.0338 m/m; with libviso2's 2 px RANSAC threshold before that: 0.0112
+  // and 0.1097 m/m). The bounds sit about 30 % above, so a 30 % regression of either VO or of
+  // the renderer fails.
   auto mean_ep = [&](const char* algo) {
     return m["algorithms"][algo]["sections"]["p_m_per_m"]["mean"].get<double>();
   };
@@ -407,7 +409,7 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   EXPECT_GT(mean_ep("sparse_kf"), 0.0);
   EXPECT_LT(std::abs(length_error_pct("sparse_kf")), 3.0);  // the twin-fidelity issue's +-3 %
   EXPECT_LT(kf["track"]["rmse_3d_pct"].get<double>(), 0.34);
-  EXPECT_LT(mean_ep("sparse"), 0.044);
+  EXPECT_LT(mean_ep("sparse"), 0.061);
   EXPECT_GT(mean_ep("sparse"), 0.0);
   EXPECT_LT(std::abs(length_error_pct("sparse")), 3.4);
   std::istringstream sections(slurp(out / "sections.csv"));
