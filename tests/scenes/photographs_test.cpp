@@ -12,6 +12,7 @@
 #include <fstream>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -36,21 +37,22 @@ TextureKind kind_named(const std::string& name) {
   return TextureKind::kGrass;
 }
 
-// Points DRIFTLAB_MATERIALS at another folder for one test.
-class MaterialsDir {
+// Sets an environment variable for one test (DRIFTLAB_MATERIALS, DRIFTLAB_ASSET_DIR).
+class ScopedEnv {
  public:
-  explicit MaterialsDir(const std::string& dir) {
-    if (const char* old = std::getenv("DRIFTLAB_MATERIALS")) old_ = old, had_ = true;
-    setenv("DRIFTLAB_MATERIALS", dir.c_str(), 1);
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old, had_ = true;
+    setenv(name, value.c_str(), 1);
   }
-  ~MaterialsDir() {
+  ~ScopedEnv() {
     if (had_)
-      setenv("DRIFTLAB_MATERIALS", old_.c_str(), 1);
+      setenv(name_, old_.c_str(), 1);
     else
-      unsetenv("DRIFTLAB_MATERIALS");
+      unsetenv(name_);
   }
 
  private:
+  const char* name_;
   std::string old_;
   bool had_ = false;
 };
@@ -123,9 +125,30 @@ TEST(Photographs, TextureIsThePhotographHalvedAndScaledToTheMean) {
   }
 }
 
+TEST(Photographs, MalformedManifestRowsNameFileLineFieldAndValue) {
+  const auto dir = test::fresh_temp_dir("bad_manifest");
+  const std::string manifest = (dir / "photographs.tsv").string();
+  const ScopedEnv env("DRIFTLAB_ASSET_DIR", dir.string());
+  const std::string sha(64, 'a');
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"grass\t" + sha + "\tx/grass.jpg\t0\tGPL-2+",
+       manifest + " line 2: 5 tab-separated fields, expected 6"},
+      {"grass\tABC\tx/grass.jpg\t0\tGPL-2+\tsomeone",
+       manifest + " line 2: field sha256: 'ABC' is not 64 lower-case hex digits"},
+      {"grass\t" + sha + "\tx/grass.jpg\t4\tGPL-2+\tsomeone",
+       manifest + " line 2: field quarter_turns: '4', expected 0, 1, 2 or 3"},
+      {"grass\t" + sha + "\tx/grass.tga\t0\tGPL-2+\tsomeone",
+       manifest + " line 2: field source: 'x/grass.tga' is not a .jpg or .png file"}};
+  for (const auto& [row, message] : cases) {
+    std::ofstream(manifest) << "# a comment\n" << row << "\n";
+    expect_user_error([] { photograph_manifest(); }, message);
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Photographs, MissingFolderNamesTheFileAndTheFetchScript) {
   const auto dir = test::fresh_temp_dir("no_materials");
-  const MaterialsDir env(dir.string());
+  const ScopedEnv env("DRIFTLAB_MATERIALS", dir.string());
   const PhotographEntry e = photograph_manifest().front();
   expect_user_error([&] { load_photograph(kind_named(e.kind), 100.0); },
                     (dir / e.file_name()).string() + "' (" + e.kind + ") is missing");
@@ -147,7 +170,7 @@ TEST(Photographs, AnotherFileIsRefusedWithBothChecksums) {
   ASSERT_FALSE(bytes.empty()) << original;
   bytes[bytes.size() / 2] ^= 1;
   std::ofstream(dir / e.file_name(), std::ios::binary) << bytes;
-  const MaterialsDir env(dir.string());
+  const ScopedEnv env("DRIFTLAB_MATERIALS", dir.string());
   const std::string message =
       test::user_error_of([&] { load_photograph(kind_named(e.kind), 100); });
   EXPECT_NE(message.find(e.sha256), std::string::npos) << message;
