@@ -129,8 +129,9 @@ int eval_command(const EvalArgs& a) {
       {"--rpe-unit", "rpe_unit", a.rpe_unit},
       {"--regress", "regression_covariates", "[" + a.regress + "]"},
       {"--reference-point", "reference_point_m", "[" + a.reference_point + "]"}};
-  for (const auto& [flag, key, value] : flags)
+  for (const auto& f : flags)
     driftlab::app::as_usage_error("", [&] {
+      const auto& [flag, key, value] = f;
       driftlab::yaml::read_into(driftlab::yaml::override_document(key + "=" + value),
                                 {flag + " " + value, false}, &in.options);
     });

@@ -166,7 +166,7 @@ struct ExternalVoStage::Export {
 
 ExternalVoStage::ExternalVoStage(const Scenario& sc, const fs::path& run_dir,
                                  const fs::path& reported_dir)
-    : sc_(sc), run_dir_(run_dir), reported_dir_(reported_dir.empty() ? run_dir : reported_dir) {
+    : run_dir_(run_dir), reported_dir_(reported_dir.empty() ? run_dir : reported_dir) {
   for (const auto& o : sc.pipeline.external_vo) {
     auto e = std::make_unique<Export>();
     e->options = o;

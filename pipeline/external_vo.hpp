@@ -51,7 +51,6 @@ class ExternalVoStage {
 
  private:
   struct Export;
-  const Scenario& sc_;
   std::filesystem::path run_dir_, reported_dir_;
   std::vector<std::unique_ptr<Export>> exports_;
 };

@@ -16,6 +16,7 @@
 #include "core/rotation.hpp"
 #include "sim/render/mip_chain.hpp"
 #include "sim/waves/wave_field.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {
 namespace {
@@ -141,7 +142,7 @@ template <class T>
 class RenderTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(DRIFTLAB_TEST_ASAN)
     // See Render.EglBackendWorksOrSaysWhy.
     if (T::value == RenderBackend::kEgl) {
       skip_reason_ = "EGL under AddressSanitizer: Mesa's unloaded DRI driver leaks its globals";
@@ -498,7 +499,7 @@ TEST(Render, MixingBackendsIsAClearError) {
 }
 
 TEST(Render, EglBackendWorksOrSaysWhy) {
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(DRIFTLAB_TEST_ASAN)
   // Mesa's EGL loads its DRI driver (swrast_dri.so), whose once-only globals it leaves behind
   // when eglTerminate unloads the driver: LeakSanitizer then reports 128 bytes from a module
   // without a name, which no suppression can match. The normal build runs this test.

@@ -9,6 +9,16 @@
 #include <string>
 #include <vector>
 
+// DRIFTLAB_TEST_ASAN: this build has AddressSanitizer (GCC defines __SANITIZE_ADDRESS__, clang
+// answers __has_feature).
+#if defined(__SANITIZE_ADDRESS__)
+#define DRIFTLAB_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define DRIFTLAB_TEST_ASAN 1
+#endif
+#endif
+
 namespace driftlab::test {
 
 /// Constants that many test files use (brought in with `using test::kPi;` and so on, so that the
