@@ -73,17 +73,20 @@ std::string scene_fingerprint(const sim::SceneGeometry& scene) {
     f.add(m.material.specular);
     f.add(m.material.double_sided);
   }
-  f.add(scene.textures.size());
-  for (const sim::Texture& t : scene.textures) {
+  const auto add_texture = [&f](const sim::Texture& t) {
     f.add(t.name);
     f.add(t.width);
     f.add(t.height);
     f.add_all(t.pixels);
-  }
+  };
+  f.add(scene.textures.size());
+  for (const sim::Texture& t : scene.textures) add_texture(t);
+  add_texture(scene.sky_clouds);
   const sim::Lighting& l = scene.lighting;
   for (const float v :
        {l.sun ? 1.f : 0.f, l.sun_direction_W.x(), l.sun_direction_W.y(), l.sun_direction_W.z(),
-        l.ambient, l.diffuse, l.sky_brightness, l.fog_distance_m})
+        l.ambient, l.diffuse, l.sky_brightness, l.fog_distance_m, l.sky_zenith_ratio, l.sky_knee,
+        l.cloud_contrast, l.cloud_height_over_tile, l.cloud_height_over_visibility})
     f.add(v);
   const sim::WaterAppearance& w = scene.water;
   for (const float v :

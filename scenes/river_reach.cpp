@@ -13,6 +13,7 @@
 #include "scenes/mesh_builder.hpp"
 #include "scenes/noise.hpp"
 #include "scenes/photographs.hpp"
+#include "scenes/sky_clouds.hpp"
 #include "scenes/textures.hpp"
 
 namespace driftlab::scenes {
@@ -661,13 +662,18 @@ sim::Lighting outdoor_lighting(Sky sky) {
     l.sky_brightness = 0.9f;
     l.fog_distance_m = 800.f;
   } else {
-    // Overcast: the sky itself is the light, strongest from straight above.
+    // Overcast: the sky itself is the light, strongest from straight above: the CIE
+    // overcast sky, three times as bright at the zenith as at the horizon (Moon and Spencer
+    // 1942), seen through the camera's highlight shoulder, which keeps the horizon at
+    // sky_brightness (the fog's grey) and the sky above it below white.
     l.sun = false;
     l.sun_direction_W = Eigen::Vector3f(0.f, 0.f, -1.f);
     l.ambient = 0.55f;
     l.diffuse = 0.45f;
     l.sky_brightness = 0.85f;
     l.fog_distance_m = 400.f;
+    l.sky_zenith_ratio = 3.f;
+    l.sky_knee = 0.8f;
   }
   return l;
 }
@@ -687,6 +693,10 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
 
   sim::SceneGeometry g;
   g.lighting = outdoor_lighting(sky);
+  if (!g.lighting.sun && options.cloud_contrast > 0) {
+    g.lighting.cloud_contrast = static_cast<float>(options.cloud_contrast);
+    g.sky_clouds = bake_cloud_layer(seed);
+  }
   g.water = sim::WaterAppearance{};
   g.water.turbidity = 0.6f;  // a lowland river after rain: murky, brownish-grey
   const Textures tex = add_textures(&g, seed, options);

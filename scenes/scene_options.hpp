@@ -33,6 +33,7 @@ struct RiverReachOptions {
   double vegetation_density = 0.6;
   double texture_contrast = 2.0;
   bool photographs = true;
+  double cloud_contrast = 0.08;
   bool bridge = true;
   bool quay_wall = true;
   int buildings = 4;
@@ -96,6 +97,11 @@ struct RiverReachOptions {
       "concrete: Debian's ufoai-textures, fetched by scripts/fetch-materials and credited in the "
       "README), each scaled to the mean grey of the procedural texture it replaces; false: "
       "procedural textures everywhere. texture_contrast applies to procedural textures only");
+    a("cloud_contrast", cloud_contrast,
+      "The overcast sky's cloud deck: relative rms of the sky's luminance it adds, before its "
+      "fading with distance (docs/renderer-and-scenes.md, Sky); 0: the sky's gradient alone. "
+      "Ignored under sky: sun",
+      yaml::in_range(0, 0.5));
     a("bridge", bridge, "Road bridge with piers across each reach tile");
     a("quay_wall", quay_wall,
       "Feature-poor sheet-piled quay wall (~30 m) on the east bank of each tile");

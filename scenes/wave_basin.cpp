@@ -51,6 +51,7 @@ sim::Lighting indoor_lighting() {
   l.diffuse = 0.4f;
   l.sky_brightness = 0.8f;    // nothing of the sky is visible; kept for the renderer's clear colour
   l.fog_distance_m = 5000.f;  // a lab hall has no haze
+  l.sky_zenith_ratio = 1.f;   // uniform: the mirror pass needs no sky
   return l;
 }
 

@@ -71,6 +71,26 @@ bool sphere_visible(const std::array<Eigen::Vector4f, 6>& planes, const Eigen::V
   return true;
 }
 
+// A scene texture on the GPU: R8, mip-mapped, trilinear, repeating.
+GLuint upload_texture(const Texture& t) {
+  if (t.width <= 0 || t.height <= 0 ||
+      t.pixels.size() != static_cast<std::size_t>(t.width) * t.height)
+    throw InternalError(fmt::format("renderer: texture '{}' has inconsistent size", t.name));
+  GLuint tex = 0;
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  const int levels = 1 + static_cast<int>(std::floor(std::log2(std::max(t.width, t.height))));
+  glTexStorage2D(GL_TEXTURE_2D, levels, GL_R8, t.width, t.height);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, t.width, t.height, GL_RED, GL_UNSIGNED_BYTE,
+                  t.pixels.data());
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  return tex;
+}
+
 }  // namespace
 
 Eigen::Matrix4f projection_from_intrinsics(const PinholeCamera& c, float n, float f) {
@@ -97,11 +117,12 @@ struct StereoRenderer::Impl {
   // Programs by variant: [mode][sun] with mode 0 gray, 1 linear depth.
   GLuint scene_progs[2][2] = {};
   GLuint water_progs[2][2][2] = {};  // [mode][sun][ripples]
-  GLuint sky_progs[2] = {};          // [sun]
+  GLuint sky_progs[2][2] = {};       // [sun][clouds]
   GLuint empty_vao = 0;
   std::vector<GpuMesh> meshes;
   std::vector<GLuint> textures;
-  SceneGeometry scene;  // lighting and water parameters (meshes released after upload)
+  GLuint cloud_tex = 0;  // scene.sky_clouds (0: none)
+  SceneGeometry scene;   // lighting and water parameters (meshes released after upload)
   std::size_t triangle_count = 0;
   GLuint water_vao = 0, water_vbo = 0, water_ebo = 0;
   GLsizei water_count = 0;
@@ -145,7 +166,10 @@ struct StereoRenderer::Impl {
   void draw_scene(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, float mirror, int mode);
   void draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, double t, int mode,
                   GLuint reflection);  // 0: none
-  void draw_sky(const Eigen::Matrix4f& view);
+  // The sky where nothing was drawn; mirror -1: the mirrored sky below the horizon.
+  void draw_sky(const Eigen::Matrix4f& view, float mirror);
+  // A sky that is the same in every direction is the reflection pass's clear colour.
+  bool uniform_sky() const { return scene.lighting.sky_zenith_ratio == 1.f && cloud_tex == 0; }
   // The ripples' slope maps at time t into ripple_tex (once per t).
   void upload_ripples(double t);
   bool reflects() const { return scene.water.enabled && options.reflections; }
@@ -184,8 +208,10 @@ StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& option
                          defines + fmt::format("#define RIPPLES {}\n", ripples));
     }
   for (int sun : {0, 1})
-    impl_->sky_progs[sun] = link_program(shaders::kSkyVs, shaders::kSkyFs, "sky",
-                                         fmt::format("#define SUN {}\n", sun) + colour);
+    for (int clouds : {0, 1})
+      impl_->sky_progs[sun][clouds] =
+          link_program(shaders::kSkyVs, shaders::kSkyFs, "sky",
+                       fmt::format("#define SUN {}\n#define CLOUDS {}\n", sun, clouds) + colour);
   glGenVertexArrays(1, &impl_->empty_vao);
   impl_->mip_chain = std::make_unique<MipChain>();
   impl_->proj = projection_from_intrinsics(rig.camera, kNear, kFar);
@@ -331,24 +357,10 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
   if (!m.textures.empty())
     glDeleteTextures(static_cast<GLsizei>(m.textures.size()), m.textures.data());
   m.textures.clear();
-  for (const Texture& t : scene.textures) {
-    if (t.width <= 0 || t.height <= 0 ||
-        t.pixels.size() != static_cast<std::size_t>(t.width) * t.height)
-      throw InternalError(fmt::format("renderer: texture '{}' has inconsistent size", t.name));
-    GLuint tex = 0;
-    glGenTextures(1, &tex);
-    glBindTexture(GL_TEXTURE_2D, tex);
-    const int levels = 1 + static_cast<int>(std::floor(std::log2(std::max(t.width, t.height))));
-    glTexStorage2D(GL_TEXTURE_2D, levels, GL_R8, t.width, t.height);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, t.width, t.height, GL_RED, GL_UNSIGNED_BYTE,
-                    t.pixels.data());
-    glGenerateMipmap(GL_TEXTURE_2D);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-    m.textures.push_back(tex);
-  }
+  for (const Texture& t : scene.textures) m.textures.push_back(upload_texture(t));
+  if (m.cloud_tex != 0) glDeleteTextures(1, &m.cloud_tex);
+  m.cloud_tex = scene.sky_clouds.pixels.empty() ? 0 : upload_texture(scene.sky_clouds);
+  glBindTexture(GL_TEXTURE_2D, 0);
   m.triangle_count = 0;
   // Batches: meshes of one material whose centres fall in the same square of
   // kBatchCell_m are drawn as one. Every draw call costs llvmpipe state
@@ -640,21 +652,43 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   glBindVertexArray(0);
 }
 
-void StereoRenderer::Impl::draw_sky(const Eigen::Matrix4f& view) {
+void StereoRenderer::Impl::draw_sky(const Eigen::Matrix4f& view, float mirror) {
   // The sky triangle lies on the far plane (depth 1): it passes the depth
   // test only where the cleared depth is left.
   glDepthFunc(GL_LEQUAL);
   glDepthMask(GL_FALSE);
-  const GLuint sky_prog = sky_progs[scene.lighting.sun ? 1 : 0];
+  const Lighting& L = scene.lighting;
+  const GLuint sky_prog = sky_progs[L.sun ? 1 : 0][cloud_tex != 0 ? 1 : 0];
   glUseProgram(sky_prog);
-  const Eigen::Matrix4f inv_vp = (proj * view).inverse();
+  // The sky is at infinity: its rays come from the view's rotation alone, so both eyes and
+  // every position see the same sky, whatever the float rounding of a translated view.
+  Eigen::Matrix4f rotation_only = view;
+  rotation_only.block<3, 1>(0, 3).setZero();
+  const Eigen::Matrix4f inv_vp = (proj * rotation_only).inverse();
   set_mat4(sky_prog, "u_inv_view_proj", inv_vp);
-  glUniform1f(loc(sky_prog, "u_sky"), scene.lighting.sky_brightness);
-  const Eigen::Vector3f sun = scene.lighting.sun_direction_W.normalized();
+  glUniform1f(loc(sky_prog, "u_sky"), static_cast<float>(sky_horizon_luminance(L)));
+  glUniform1f(loc(sky_prog, "u_gradient"), L.sky_zenith_ratio - 1.f);
+  glUniform1f(loc(sky_prog, "u_knee"), L.sky_knee);
+  glUniform1f(loc(sky_prog, "u_mirror"), mirror);
+  const Eigen::Vector3f sun = L.sun_direction_W.normalized();
   glUniform3f(loc(sky_prog, "u_sun_dir"), sun.x(), sun.y(), sun.z());
+  // The sun's image in the water is the water's glint, not a mirrored halo.
+  glUniform1f(loc(sky_prog, "u_halo"), mirror > 0 ? 0.35f : 0.f);
+  if (cloud_tex != 0) {
+    glActiveTexture(GL_TEXTURE3);  // 0: scene or reflection, 1-2: ripples
+    glBindTexture(GL_TEXTURE_2D, cloud_tex);
+    glUniform1i(loc(sky_prog, "u_clouds"), 3);
+    glUniform1f(loc(sky_prog, "u_cloud_scale"), L.cloud_height_over_tile);
+    glUniform1f(loc(sky_prog, "u_cloud_gain"), L.cloud_contrast * 255.f / 32.f);
+    glUniform1f(loc(sky_prog, "u_cloud_haze"), L.cloud_height_over_visibility);
+  }
   glBindVertexArray(empty_vao);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glBindVertexArray(0);
+  if (cloud_tex != 0) {
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glActiveTexture(GL_TEXTURE0);
+  }
   glDepthMask(GL_TRUE);
   glDepthFunc(GL_LESS);
 }
@@ -674,6 +708,9 @@ void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, int eye_index) {
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_CLIP_DISTANCE0);
   draw_scene(view, eye, -1.f, 0);
+  // The mirrored sky where the ray looks down; where it looks up, the clear colour is the
+  // sky at the horizon, so ripples that sample across the line see no step.
+  if (!uniform_sky()) draw_sky(view, -1.f);
   glDisable(GL_CLIP_DISTANCE0);
   if (multisampled) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, e.refl_msaa_fbo);
@@ -714,7 +751,7 @@ void StereoRenderer::Impl::draw_eye_rows(const SE3& T_W_C, double t, int eye_ind
   // was drawn: every pixel is shaded about once.
   draw_water(view, eye, t, 0, reflects() ? e.refl_tex : 0);
   draw_scene(view, eye, 1.f, 0);
-  draw_sky(view);
+  draw_sky(view, 1.f);
   if (band) glDisable(GL_SCISSOR_TEST);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }

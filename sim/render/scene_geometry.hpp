@@ -3,7 +3,9 @@
 // module builds one of these from the scenario; the renderer uploads it once.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -64,7 +66,29 @@ struct Lighting {
   float diffuse = 0.45f;                               // directional part
   float sky_brightness = 0.85f;                        // sky gray level at the horizon [0, 1]
   float fog_distance_m = 400.f;                        // distance at which fog reaches 63% [m]
+  // The sky's luminance by elevation e: L_h (1 + (r - 1) sin e), r = L(zenith) / L(horizon).
+  // r = 3 is the CIE overcast sky (Moon and Spencer 1942, CIE standard sky 1); 1 a uniform sky.
+  float sky_zenith_ratio = 1.12f;
+  // The camera's highlight shoulder on the sky: luminance above the knee k is compressed as
+  // k + (1 - k)(1 - exp(-(L - k)/(1 - k))), so a bright overcast sky keeps its gradient and
+  // clouds below white. >= 1: plain clipping at 1. sky_brightness is the horizon's grey after
+  // the shoulder (the fog's colour), the renderer finds the luminance that gives it.
+  float sky_knee = 1.0f;
+  // The cloud deck (SceneGeometry::sky_clouds): relative rms of the sky's luminance it adds
+  // (0: none), its height over the texture's tile (the deck's scale) and over the visibility
+  // (its contrast fades as exp(-(H/V) / sin e) along the slant path).
+  float cloud_contrast = 0.f;
+  float cloud_height_over_tile = 0.0625f;
+  float cloud_height_over_visibility = 0.05f;
 };
+
+/// The sky's luminance at the horizon before the shoulder (Lighting::sky_knee): the inverse of
+/// the shoulder at sky_brightness, L_h = k - (1 - k) ln(1 - (b - k)/(1 - k)) for b > k.
+inline double sky_horizon_luminance(const Lighting& l) {
+  const double k = l.sky_knee, b = std::min(static_cast<double>(l.sky_brightness), 0.999);
+  if (k >= 1.0 || b <= k) return l.sky_brightness;
+  return k - (1.0 - k) * std::log(1.0 - (b - k) / (1.0 - k));
+}
 
 /// The water surface: a plane at still-water level (z = 0) displaced by the
 /// wave field, with reflection and a body colour.
@@ -81,6 +105,8 @@ struct SceneGeometry {
   std::vector<Texture> textures;
   Lighting lighting;
   WaterAppearance water;
+  // The cloud deck's texture: unit-variance noise n stored as 128 + 32 n, tiling (empty: none).
+  Texture sky_clouds;
 
   std::size_t triangle_count() const {
     std::size_t n = 0;

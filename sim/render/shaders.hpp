@@ -6,8 +6,9 @@
 namespace driftlab::sim::shaders {
 
 // Shaders come in variants chosen by #defines: DEPTH (linear depth instead of
-// gray), SUN (sun glints, which need per-pixel normals and view vectors) and COLOUR (RGB
-// images: the scene's materials tinted by their colour, water and sky gray).
+// gray), SUN (sun glints, which need per-pixel normals and view vectors), COLOUR (RGB
+// images: the scene's materials tinted by their colour, water and sky gray) and, for the sky,
+// CLOUDS (the cloud deck's texture).
 // On llvmpipe the cost of a fragment is mostly the interpolation of its
 // inputs, so each variant carries only what it reads: lighting and fog are
 // smooth over a triangle and are evaluated per vertex (Gouraud).
@@ -105,30 +106,57 @@ void main() {
 // The sky: one triangle over the screen on the far plane. The (unnormalised)
 // viewing ray is affine in window coordinates, so it is computed at the
 // vertices and interpolated without perspective: exact, and cheap per pixel.
+// In the mirror pass (u_mirror -1) a pixel shows the sky in the mirrored
+// direction, and only where its ray looks down: the clip distance is the ray's
+// z, affine over the screen like the ray, so the horizon is cut exactly.
 inline constexpr const char* kSkyVs = R"(
 uniform mat4 u_inv_view_proj;
+uniform float u_mirror;
 noperspective out vec3 v_ray;
 void main() {
   vec2 p = vec2((gl_VertexID == 1) ? 3.0 : -1.0, (gl_VertexID == 2) ? 3.0 : -1.0);
   vec4 a = u_inv_view_proj * vec4(p, -1.0, 1.0);
   vec4 b = u_inv_view_proj * vec4(p, 1.0, 1.0);
   v_ray = b.xyz / b.w - a.xyz / a.w;
+  gl_ClipDistance[0] = u_mirror < 0.0 ? v_ray.z : 1.0;
   gl_Position = vec4(p, 1.0, 1.0);
 }
 )";
 
+// The sky's luminance (Lighting): the gradient L_h (1 + (r - 1) sin e), the
+// cloud deck at height H read where the ray meets it (d.xy H / sin e, in
+// tiles), its contrast faded along the slant path, then the highlight shoulder.
 inline constexpr const char* kSkyFs = R"(
 noperspective in vec3 v_ray;
-uniform float u_sky;
+uniform float u_sky;       // L_h: the horizon's luminance before the shoulder
+uniform float u_gradient;  // r - 1
+uniform float u_knee;      // >= 1: clip at 1
+uniform float u_mirror;
+#if CLOUDS
+uniform sampler2D u_clouds;  // n as 128 + 32 n
+uniform float u_cloud_scale; // H / tile
+uniform float u_cloud_gain;  // contrast 255 / 32
+uniform float u_cloud_haze;  // H / visibility
+#endif
+#if SUN
 uniform vec3 u_sun_dir;
+uniform float u_halo;
+#endif
 out vec4 frag;
 void main() {
-  vec3 d = normalize(v_ray);
-  float elevation = clamp(-d.z, 0.0, 1.0);   // z is down
-  float g = u_sky * (1.0 + 0.12 * elevation);
-#if SUN
-  g += 0.35 * pow(max(dot(d, u_sun_dir), 0.0), 200.0);
+  vec3 d = normalize(v_ray * vec3(1.0, 1.0, u_mirror));
+  float s = clamp(-d.z, 0.0, 1.0);   // sin(elevation); z is down
+  float g = u_sky * (1.0 + u_gradient * s);
+#if CLOUDS
+  float inv_s = 1.0 / max(s, 1e-3);
+  float n = texture(u_clouds, d.xy * (u_cloud_scale * inv_s)).r - 128.0 / 255.0;
+  g *= 1.0 + u_cloud_gain * n * exp(-u_cloud_haze * inv_s);
 #endif
+#if SUN
+  g += u_halo * pow(max(dot(d, u_sun_dir), 0.0), 200.0);
+#endif
+  if (u_knee < 1.0 && g > u_knee)
+    g = u_knee + (1.0 - u_knee) * (1.0 - exp((u_knee - g) / (1.0 - u_knee)));
 #if COLOUR
   frag = vec4(vec3(min(g, 1.0)), 1.0);
 #else

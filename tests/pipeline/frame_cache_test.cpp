@@ -257,6 +257,13 @@ TEST(FrameCacheKey, NamesEverythingThatDecidesTheFrames) {
       {"a texture pixel", [](KeyInputs& k) { k.scene.textures[0].pixels[3] ^= 1; }},
       {"a vertex", [](KeyInputs& k) { k.scene.meshes[0].vertices[1].x = 1.0001f; }},
       {"the lighting", [](KeyInputs& k) { k.scene.lighting.sun = true; }},
+      {"the sky's gradient", [](KeyInputs& k) { k.scene.lighting.sky_zenith_ratio = 3.f; }},
+      {"the sky's shoulder", [](KeyInputs& k) { k.scene.lighting.sky_knee = 0.8f; }},
+      {"the clouds' contrast", [](KeyInputs& k) { k.scene.lighting.cloud_contrast = 0.1f; }},
+      {"a cloud pixel",
+       [](KeyInputs& k) {
+         k.scene.sky_clouds = {"sky_clouds", 1, 1, {128}};
+       }},
       {"a pose by 1e-12 m",
        [](KeyInputs& k) { k.truth[1].T_W_B = SE3(Quat::Identity(), Vec3(0.1 + 1e-12, 0, 0)); }},
       {"a dropped frame", [](KeyInputs& k) { k.stamps[2].dropped = true; }},

@@ -387,12 +387,14 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
 
   // Accuracy on frames from the real renderer, shipped defaults (the river paper's Bumblebee2
   // camera, photographed materials and procedural textures at contrast 2, the reflection pass
-  // at full resolution). Measured on 2026-11-29 with the photographed materials: sparse_kf
-  // e'_p 0.0042 m/m, length +0.1 %, 3D RMSE 0.24 % of the track; sparse (the paper's
-  // frame-to-frame method) 0.0467 m/m, length -2.8 % (procedural textures everywhere,
-  // 2026-11-26: 0.0045 and 0.0338 m/m; with libviso2's 2 px RANSAC threshold before that: 0.0112
-  // and 0.1097 m/m). The bounds sit about 30 % above, so a 30 % regression of either VO or of
-  // the renderer fails.
+  // at full resolution, the overcast sky with its clouds). Measured on 2026-11-29 with the
+  // overcast sky: sparse_kf e'_p 0.0070 m/m, length +0.1 %, 3D RMSE 0.38 % of the track; sparse
+  // (the paper's frame-to-frame method) 0.0470 m/m, length -2.7 % (the flat sky before, the
+  // same day: 0.0042 and 0.0467 m/m; procedural textures everywhere, 2026-11-26: 0.0045 and
+  // 0.0338 m/m). Two sections make sparse_kf's figure noisy: over seeds 1-3 of a similar leg it
+  // was 0.0071, 0.0043, 0.0052 with the new sky and 0.0032, 0.0032, 0.0068 with the flat one,
+  // and the CI gate's 80 paired sections saw no change (+2.9 %, p = 0.39). The bounds sit about
+  // 30 % above, so a 30 % regression of either VO or of the renderer fails.
   auto mean_ep = [&](const char* algo) {
     return m["algorithms"][algo]["sections"]["p_m_per_m"]["mean"].get<double>();
   };
@@ -405,10 +407,10 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
       "3D RMSE %.2f %%\n",
       mean_ep("sparse"), length_error_pct("sparse"), mean_ep("sparse_kf"),
       length_error_pct("sparse_kf"), kf["track"]["rmse_3d_pct"].get<double>());
-  EXPECT_LT(mean_ep("sparse_kf"), 0.0059);
+  EXPECT_LT(mean_ep("sparse_kf"), 0.0091);
   EXPECT_GT(mean_ep("sparse_kf"), 0.0);
   EXPECT_LT(std::abs(length_error_pct("sparse_kf")), 3.0);  // the twin-fidelity issue's +-3 %
-  EXPECT_LT(kf["track"]["rmse_3d_pct"].get<double>(), 0.34);
+  EXPECT_LT(kf["track"]["rmse_3d_pct"].get<double>(), 0.50);
   EXPECT_LT(mean_ep("sparse"), 0.061);
   EXPECT_GT(mean_ep("sparse"), 0.0);
   EXPECT_LT(std::abs(length_error_pct("sparse")), 3.4);
