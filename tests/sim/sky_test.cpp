@@ -68,6 +68,14 @@ Texture smooth_clouds(int size) {
   return t;
 }
 
+// The CIE sky (r = 3) with a cloud deck of `contrast` on a smooth texture of `size` texels.
+SceneGeometry clouded_sky(float brightness, float knee, float contrast, int size) {
+  SceneGeometry s = empty_sky(brightness, 3.f, knee);
+  s.lighting.cloud_contrast = contrast;
+  s.sky_clouds = smooth_clouds(size);
+  return s;
+}
+
 // The camera's shoulder (Lighting::sky_knee), as the scene documents it.
 double shoulder(double x, double k) {
   if (k >= 1 || x <= k) return std::min(x, 1.0);
@@ -123,9 +131,7 @@ TEST(OvercastSky, ShoulderKeepsTheHorizonAtTheFogGrey) {
 
 TEST(OvercastSky, CloudsLieAtInfinityFixedInTheWorld) {
   StereoRenderer renderer(sky_rig(), RenderOptions{});
-  SceneGeometry s = empty_sky(0.3f, 3.f, 1.f);
-  s.lighting.cloud_contrast = 0.3f;
-  s.sky_clouds = smooth_clouds(64);
+  SceneGeometry s = clouded_sky(0.3f, 1.f, 0.3f, 64);
   renderer.upload(s);
   const SE3 T = sky_camera(Vec3(0, 0, -1), 20 * kDeg);
   const StereoImages a = renderer.render(T, 0.0, false);
@@ -162,9 +168,7 @@ TEST(OvercastSky, CloudsLieAtInfinityFixedInTheWorld) {
 
 TEST(OvercastSky, CalmWaterMirrorsTheSkyWithFresnelsReflectance) {
   StereoRenderer renderer(sky_rig(), RenderOptions{});
-  SceneGeometry s = empty_sky(0.3f, 3.f, 1.f);
-  s.lighting.cloud_contrast = 0.3f;
-  s.sky_clouds = smooth_clouds(64);
+  SceneGeometry s = clouded_sky(0.3f, 1.f, 0.3f, 64);
   s.water.enabled = true;
   s.water.body_gray = 0.f;
   s.water.turbidity = 0.f;
@@ -237,9 +241,7 @@ TEST(OvercastSky, SunnySkyKeepsItsFormula) {
 
 TEST(OvercastSky, CloudedRendersAreByteIdentical) {
   StereoRenderer renderer(sky_rig(), RenderOptions{});
-  SceneGeometry s = empty_sky(0.85f, 3.f, 0.8f);
-  s.lighting.cloud_contrast = 0.08f;
-  s.sky_clouds = smooth_clouds(128);
+  SceneGeometry s = clouded_sky(0.85f, 0.8f, 0.08f, 128);
   s.water.enabled = true;
   renderer.upload(s);
   const SE3 T = sky_camera(Vec3(0, 0, -0.5), 3 * kDeg);
