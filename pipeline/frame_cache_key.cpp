@@ -78,6 +78,7 @@ std::string scene_fingerprint(const sim::SceneGeometry& scene) {
     f.add(t.width);
     f.add(t.height);
     f.add_all(t.pixels);
+    f.add_all(t.alpha);  // which texels are drawn (an alpha-tested texture)
   };
   f.add(scene.textures.size());
   for (const sim::Texture& t : scene.textures) add_texture(t);

@@ -17,6 +17,7 @@
 #include <tuple>
 
 #include "core/error.hpp"
+#include "sim/render/alpha_mips.hpp"
 #include "sim/render/gl_program.hpp"
 #include "sim/render/mip_chain.hpp"
 #include "sim/render/mip_chain_gl.hpp"
@@ -30,7 +31,8 @@ struct GpuMesh {
   GLuint vao = 0, vbo = 0, ebo = 0;
   GLsizei count = 0;
   Material material;
-  bool on_body = false;                              // Mesh::on_body
+  bool on_body = false;  // Mesh::on_body
+  bool cutout = false;   // its texture has alpha: drawn alpha-tested, after the opaque meshes
   Eigen::Vector3f centre = Eigen::Vector3f::Zero();  // bounding sphere, mesh frame
   float radius = 0;
 };
@@ -71,11 +73,32 @@ bool sphere_visible(const std::array<Eigen::Vector4f, 6>& planes, const Eigen::V
   return true;
 }
 
-// A scene texture on the GPU: R8, mip-mapped, trilinear, repeating.
+// An alpha-tested texture on the GPU: RG8 (grey, alpha), its levels keeping level 0's coverage
+// (computed on the CPU: glGenerateMipmap's box filter thins leaves out with distance), the
+// nearest level bilinearly filtered (no blend of two levels' edges), clamped at its edges.
+GLuint upload_cutout_texture(const Texture& t) {
+  GLuint tex = 0;
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  const std::vector<AlphaMipLevel> levels = coverage_preserving_mips(t);
+  glTexStorage2D(GL_TEXTURE_2D, static_cast<GLsizei>(levels.size()), GL_RG8, t.width, t.height);
+  for (std::size_t k = 0; k < levels.size(); ++k)
+    glTexSubImage2D(GL_TEXTURE_2D, static_cast<GLint>(k), 0, 0, levels[k].width, levels[k].height,
+                    GL_RG, GL_UNSIGNED_BYTE, levels[k].grey_alpha.data());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return tex;
+}
+
+// A scene texture on the GPU: R8, mip-mapped, trilinear, repeating; RG8 where it has alpha.
 GLuint upload_texture(const Texture& t) {
-  if (t.width <= 0 || t.height <= 0 ||
-      t.pixels.size() != static_cast<std::size_t>(t.width) * t.height)
+  const auto n = static_cast<std::size_t>(std::max(t.width, 0)) * std::max(t.height, 0);
+  if (t.width <= 0 || t.height <= 0 || t.pixels.size() != n ||
+      (!t.alpha.empty() && t.alpha.size() != n))
     throw InternalError(fmt::format("renderer: texture '{}' has inconsistent size", t.name));
+  if (!t.alpha.empty()) return upload_cutout_texture(t);
   GLuint tex = 0;
   glGenTextures(1, &tex);
   glBindTexture(GL_TEXTURE_2D, tex);
@@ -114,8 +137,8 @@ struct StereoRenderer::Impl {
   Eigen::Matrix4f T_W_B = Eigen::Matrix4f::Identity();  // where body meshes are drawn
   std::unique_ptr<GlContext> context;
   std::unique_ptr<MipChain> mip_chain;  // the mirror image's blur levels under wind ripples
-  // Programs by variant: [mode][sun] with mode 0 gray, 1 linear depth.
-  GLuint scene_progs[2][2] = {};
+  // Programs by variant: [mode][sun][cutout] with mode 0 gray, 1 linear depth.
+  GLuint scene_progs[2][2][2] = {};
   GLuint water_progs[2][2][2] = {};  // [mode][sun][ripples]
   GLuint sky_progs[2][2] = {};       // [sun][clouds]
   GLuint empty_vao = 0;
@@ -164,6 +187,7 @@ struct StereoRenderer::Impl {
   // The eyes' colour format: R8 gray, RGBA8 colour.
   unsigned eye_format() const { return colour ? GL_RGBA8 : GL_R8; }
   void draw_scene(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, float mirror, int mode);
+  void draw_mesh(GLuint prog, const GpuMesh& g);  // one mesh with the program in use
   void draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, double t, int mode,
                   GLuint reflection);  // 0: none
   // The sky where nothing was drawn; mirror -1: the mirrored sky below the horizon.
@@ -200,8 +224,10 @@ StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& option
     for (int sun : {0, 1}) {
       const std::string defines =
           fmt::format("#define DEPTH {}\n#define SUN {}\n", mode, sun) + colour;
-      impl_->scene_progs[mode][sun] =
-          link_program(shaders::kSceneVs, shaders::kSceneFs, "scene", defines);
+      for (int cutout : {0, 1})
+        impl_->scene_progs[mode][sun][cutout] =
+            link_program(shaders::kSceneVs, shaders::kSceneFs, "scene",
+                         defines + fmt::format("#define CUTOUT {}\n", cutout));
       for (int ripples : {0, 1})
         impl_->water_progs[mode][sun][ripples] =
             link_program(shaders::kWaterVs, shaders::kWaterFs, "water",
@@ -400,6 +426,8 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     GpuMesh g;
     g.material = mesh.material;
     g.on_body = mesh.on_body;
+    g.cutout = mesh.material.texture >= 0 &&
+               !scene.textures[static_cast<std::size_t>(mesh.material.texture)].alpha.empty();
     g.count = static_cast<GLsizei>(mesh.indices.size());
     Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = -lo;
     for (const Vertex& v : mesh.vertices) {
@@ -502,19 +530,21 @@ void StereoRenderer::set_waves(const std::vector<WaveComponent>& components) {
 void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye,
                                       float mirror, int mode) {
   const Lighting& L = scene.lighting;
-  const GLuint scene_prog = scene_progs[mode][L.sun ? 1 : 0];
-  glUseProgram(scene_prog);
-  set_mat4(scene_prog, "u_view", view);
-  set_mat4(scene_prog, "u_proj", proj);
-  glUniform1f(loc(scene_prog, "u_mirror"), mirror);
+  const int sun_variant = L.sun ? 1 : 0;
   const Eigen::Vector3f sun = L.sun_direction_W.normalized();
-  glUniform3f(loc(scene_prog, "u_sun_dir"), sun.x(), sun.y(), sun.z());
-  glUniform1f(loc(scene_prog, "u_ambient"), L.ambient);
-  glUniform1f(loc(scene_prog, "u_diffuse"), L.diffuse);
-  glUniform1f(loc(scene_prog, "u_sky"), L.sky_brightness);
-  glUniform1f(loc(scene_prog, "u_fog"), L.fog_distance_m);
-  glUniform3f(loc(scene_prog, "u_eye"), eye.x(), eye.y(), eye.z() * mirror);
-  glUniform1i(loc(scene_prog, "u_tex"), 0);
+  const auto set_pass_uniforms = [&](GLuint prog) {
+    glUseProgram(prog);
+    set_mat4(prog, "u_view", view);
+    set_mat4(prog, "u_proj", proj);
+    glUniform1f(loc(prog, "u_mirror"), mirror);
+    glUniform3f(loc(prog, "u_sun_dir"), sun.x(), sun.y(), sun.z());
+    glUniform1f(loc(prog, "u_ambient"), L.ambient);
+    glUniform1f(loc(prog, "u_diffuse"), L.diffuse);
+    glUniform1f(loc(prog, "u_sky"), L.sky_brightness);
+    glUniform1f(loc(prog, "u_fog"), L.fog_distance_m);
+    glUniform3f(loc(prog, "u_eye"), eye.x(), eye.y(), eye.z() * mirror);
+    glUniform1i(loc(prog, "u_tex"), 0);
+  };
   glActiveTexture(GL_TEXTURE0);
   // Meshes outside the view are skipped: a CPU rasteriser is bound by vertex work.
   // Nearest first, so that llvmpipe's early depth test skips shading hidden
@@ -538,25 +568,38 @@ void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::
   // wound counter-clockwise about its normal is clockwise on screen; the mirror image flips the
   // winding once more.
   glFrontFace(mirror > 0.f ? GL_CW : GL_CCW);
-  for (const auto& [distance, index] : draw_order) {
-    const GpuMesh& g = meshes[index];
-    if (g.material.double_sided)
-      glDisable(GL_CULL_FACE);
-    else
-      glEnable(GL_CULL_FACE);
-    const bool has_tex = g.material.texture >= 0;
-    glUniform1i(loc(scene_prog, "u_has_tex"), has_tex ? 1 : 0);
-    if (has_tex)
-      glBindTexture(GL_TEXTURE_2D, textures[static_cast<std::size_t>(g.material.texture)]);
-    glUniform1f(loc(scene_prog, "u_albedo"), g.material.albedo);
-    glUniform1f(loc(scene_prog, "u_specular"), g.material.specular);
-    glUniform3fv(loc(scene_prog, "u_tint"), 1, g.material.colour.data());
-    set_mat4(scene_prog, "u_model", g.on_body ? T_W_B : Eigen::Matrix4f::Identity().eval());
-    glBindVertexArray(g.vao);
-    glDrawElements(GL_TRIANGLES, g.count, GL_UNSIGNED_INT, nullptr);
+  // Opaque meshes first, then the alpha-tested ones (each group nearest first): a discarding
+  // shader tests depth early but writes it late on llvmpipe, so cards drawn last meet a depth
+  // buffer that already rejects what opaque surfaces hide.
+  for (int cutout : {0, 1}) {
+    const GLuint prog = scene_progs[mode][sun_variant][cutout];
+    bool bound = false;
+    for (const auto& [distance, index] : draw_order) {
+      const GpuMesh& g = meshes[index];
+      if (g.cutout != (cutout == 1)) continue;
+      if (!bound) set_pass_uniforms(prog);
+      bound = true;
+      draw_mesh(prog, g);
+    }
   }
   glBindVertexArray(0);
   glDisable(GL_CULL_FACE);
+}
+
+void StereoRenderer::Impl::draw_mesh(GLuint prog, const GpuMesh& g) {
+  if (g.material.double_sided)
+    glDisable(GL_CULL_FACE);
+  else
+    glEnable(GL_CULL_FACE);
+  const bool has_tex = g.material.texture >= 0;
+  glUniform1i(loc(prog, "u_has_tex"), has_tex ? 1 : 0);
+  if (has_tex) glBindTexture(GL_TEXTURE_2D, textures[static_cast<std::size_t>(g.material.texture)]);
+  glUniform1f(loc(prog, "u_albedo"), g.material.albedo);
+  glUniform1f(loc(prog, "u_specular"), g.material.specular);
+  glUniform3fv(loc(prog, "u_tint"), 1, g.material.colour.data());
+  set_mat4(prog, "u_model", g.on_body ? T_W_B : Eigen::Matrix4f::Identity().eval());
+  glBindVertexArray(g.vao);
+  glDrawElements(GL_TRIANGLES, g.count, GL_UNSIGNED_INT, nullptr);
 }
 
 void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye,

@@ -28,7 +28,15 @@ struct Texture {
   int width = 0;
   int height = 0;
   std::vector<std::uint8_t> pixels;
+  // Empty: opaque. Otherwise width x height coverages (row-major, as pixels): a mesh whose
+  // material's texture has alpha is alpha-tested (a texel is drawn where its filtered alpha is
+  // at least kAlphaOpaqueFrom / 255, never blended), in colour, depth and the mirror pass alike;
+  // its mip levels keep the coverage of level 0 (sim/render/alpha_mips.hpp). Leaf-cluster cards.
+  std::vector<std::uint8_t> alpha;
 };
+
+/// The alpha (0-255) from which a texel of an alpha-tested texture is drawn (0.5 after filtering).
+inline constexpr std::uint8_t kAlphaOpaqueFrom = 128;
 
 /// How a mesh reflects light.
 struct Material {

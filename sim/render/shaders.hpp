@@ -7,8 +7,10 @@ namespace driftlab::sim::shaders {
 
 // Shaders come in variants chosen by #defines: DEPTH (linear depth instead of
 // gray), SUN (sun glints, which need per-pixel normals and view vectors), COLOUR (RGB
-// images: the scene's materials tinted by their colour, water and sky gray) and, for the sky,
-// CLOUDS (the cloud deck's texture).
+// images: the scene's materials tinted by their colour, water and sky gray), for the scene
+// CUTOUT (an alpha-tested texture, grey in r and alpha in g: fragments under 0.5 are discarded in
+// every pass, so the depth and mirror images show the same holes) and, for the sky, CLOUDS (the
+// cloud deck's texture).
 // On llvmpipe the cost of a fragment is mostly the interpolation of its
 // inputs, so each variant carries only what it reads: lighting and fog are
 // smooth over a triangle and are evaluated per vertex (Gouraud).
@@ -27,6 +29,9 @@ uniform float u_fog;
 uniform vec3 u_eye;
 #if DEPTH
 out float v_view_z;
+#if CUTOUT
+out vec2 v_uv;
+#endif
 #else
 out vec4 v_uv_light_fog;   // texture u, v; light; fog transmittance
 #endif
@@ -40,6 +45,9 @@ void main() {
   vec4 c = u_view * vec4(p, 1.0);
 #if DEPTH
   v_view_z = c.z;
+#if CUTOUT
+  v_uv = a_uv;
+#endif
 #else
   vec3 m = mat3(u_model) * a_normal;
   vec3 n = normalize(vec3(m.xy, m.z * u_mirror));
@@ -64,6 +72,9 @@ void main() {
 inline constexpr const char* kSceneFs = R"(
 #if DEPTH
 in float v_view_z;
+#if CUTOUT
+in vec2 v_uv;
+#endif
 #else
 in vec4 v_uv_light_fog;
 #endif
@@ -82,9 +93,18 @@ uniform vec3 u_eye;
 out vec4 frag;
 void main() {
 #if DEPTH
+#if CUTOUT
+  if (texture(u_tex, v_uv).g < 0.5) discard;
+#endif
   frag = vec4(v_view_z, 0.0, 0.0, 1.0);
 #else
+#if CUTOUT
+  vec2 ta = texture(u_tex, v_uv_light_fog.xy).rg;
+  if (ta.g < 0.5) discard;
+  float t = ta.r;
+#else
   float t = u_has_tex ? texture(u_tex, v_uv_light_fog.xy).r : 1.0;
+#endif
   float g = u_albedo * t * v_uv_light_fog.z;
 #if SUN
   if (u_specular > 0.0) {

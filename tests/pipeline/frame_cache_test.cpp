@@ -224,7 +224,7 @@ struct KeyInputs {
     m.indices = {0, 1, 2};
     m.material.texture = 0;
     scene.meshes.push_back(m);
-    scene.textures.push_back({"bark", 2, 2, {10, 20, 30, 40}});
+    scene.textures.push_back({"bark", 2, 2, {10, 20, 30, 40}, {}});
     for (int k = 0; k < 3; ++k) {
       FrameTruth f;
       f.t_s = k / 13.0;
@@ -255,6 +255,10 @@ TEST(FrameCacheKey, NamesEverythingThatDecidesTheFrames) {
       {"the wind", [](KeyInputs& k) { k.sc.water.wind.speed_mps += 0.5; }},
       {"the frames asked for", [](KeyInputs& k) { k.sc.pipeline.max_frames = 7; }},
       {"a texture pixel", [](KeyInputs& k) { k.scene.textures[0].pixels[3] ^= 1; }},
+      {"a texture's alpha (drawn alpha-tested)",
+       [](KeyInputs& k) {
+         k.scene.textures[0].alpha = {255, 255, 0, 255};
+       }},
       {"a vertex", [](KeyInputs& k) { k.scene.meshes[0].vertices[1].x = 1.0001f; }},
       {"the lighting", [](KeyInputs& k) { k.scene.lighting.sun = true; }},
       {"the sky's gradient", [](KeyInputs& k) { k.scene.lighting.sky_zenith_ratio = 3.f; }},
@@ -262,7 +266,7 @@ TEST(FrameCacheKey, NamesEverythingThatDecidesTheFrames) {
       {"the clouds' contrast", [](KeyInputs& k) { k.scene.lighting.cloud_contrast = 0.1f; }},
       {"a cloud pixel",
        [](KeyInputs& k) {
-         k.scene.sky_clouds = {"sky_clouds", 1, 1, {128}};
+         k.scene.sky_clouds = {"sky_clouds", 1, 1, {128}, {}};
        }},
       {"a pose by 1e-12 m",
        [](KeyInputs& k) { k.truth[1].T_W_B = SE3(Quat::Identity(), Vec3(0.1 + 1e-12, 0, 0)); }},

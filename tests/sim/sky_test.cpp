@@ -55,7 +55,7 @@ SceneGeometry empty_sky(float brightness, float zenith_ratio, float knee) {
 // A smooth cloud texture, 128 + 32 n: three tiling waves (periods 21 to 64 texels), so that
 // bilinear resampling of the rendered sky is exact to well under a grey level.
 Texture smooth_clouds(int size) {
-  Texture t{"sky_clouds", size, size, {}};
+  Texture t{"sky_clouds", size, size, {}, {}};
   const double w = 2 * std::numbers::pi / size;
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x) {
