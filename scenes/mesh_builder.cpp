@@ -147,3 +147,108 @@ void add_mesh(sim::SceneGeometry* scene, sim::Mesh mesh) {
 }
 
 }  // namespace driftlab::scenes
+
+namespace driftlab::scenes {
+
+namespace {
+
+// A unit vector perpendicular to the unit vector w.
+Vec3 any_perpendicular(const Vec3& w) {
+  return (std::abs(w.z()) < 0.9 ? w.cross(Vec3::UnitZ()) : w.cross(Vec3::UnitX())).normalized();
+}
+
+// Unit tangents at the polyline's points: the mean of the adjacent segments' directions
+// (one-sided at the ends); a zero-length segment takes its neighbour's direction.
+std::vector<Vec3> polyline_tangents(const std::vector<Vec3>& p) {
+  const std::size_t n = p.size();
+  std::vector<Vec3> seg(n - 1);
+  Vec3 last = Vec3::Zero();
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    const Vec3 d = p[i + 1] - p[i];
+    seg[i] = d.norm() > 1e-12 ? Vec3(d.normalized()) : last;
+    if (seg[i].squaredNorm() > 0) last = seg[i];
+  }
+  for (std::size_t i = n - 1; i-- > 0;)  // leading zero segments take the next direction
+    if (seg[i].squaredNorm() == 0) seg[i] = i + 1 < n - 1 ? seg[i + 1] : Vec3(-Vec3::UnitZ());
+  std::vector<Vec3> t(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 a = seg[i == 0 ? 0 : i - 1], b = seg[i + 1 == n ? n - 2 : i];
+    const Vec3 m = a + b;
+    t[i] = m.norm() > 1e-9 ? Vec3(m.normalized()) : b;
+  }
+  return t;
+}
+
+}  // namespace
+
+void MeshBuilder::tube(const std::vector<Vec3>& points, const std::vector<double>& radii, int sides,
+                       double repeat_m) {
+  DRIFTLAB_DEMAND_MSG(points.size() >= 2 && radii.size() == points.size() && sides >= 3,
+                      "tube needs >= 2 points, one radius per point and >= 3 sides");
+  const std::size_t n = points.size();
+  const std::vector<Vec3> t = polyline_tangents(points);
+  // Frames by double reflection (Wang, Juettler, Zheng and Liu 2008, "Computation of rotation
+  // minimizing frames", algorithm 1): e1 is carried from ring to ring without twisting.
+  std::vector<Vec3> e1(n);
+  e1[0] = any_perpendicular(t[0]);
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    const Vec3 v1 = points[i + 1] - points[i];
+    const double c1 = v1.squaredNorm();
+    Vec3 r = e1[i], tl = t[i];
+    if (c1 > 1e-24) {
+      r -= (2 / c1) * v1.dot(r) * v1;
+      tl -= (2 / c1) * v1.dot(tl) * v1;
+    }
+    const Vec3 v2 = t[i + 1] - tl;
+    const double c2 = v2.squaredNorm();
+    if (c2 > 1e-24) r -= (2 / c2) * v2.dot(r) * v2;
+    r -= r.dot(t[i + 1]) * t[i + 1];  // remove rounding drift
+    e1[i + 1] = r.norm() > 1e-9 ? Vec3(r.normalized()) : any_perpendicular(t[i + 1]);
+  }
+  const double r_max = *std::max_element(radii.begin(), radii.end());
+  const bool tip = radii.back() <= 1e-6 * r_max || radii.back() < 1e-9;
+  const double repeats = std::max(1.0, std::round(2 * std::numbers::pi * radii[0] / repeat_m));
+  auto radial = [&](std::size_t i, double ang) {
+    return Vec3(std::cos(ang) * e1[i] + std::sin(ang) * t[i].cross(e1[i]));
+  };
+  const std::size_t rings = tip ? n - 1 : n;
+  std::vector<std::vector<std::uint32_t>> ring(rings);
+  double along_m = 0;
+  for (std::size_t i = 0; i < rings; ++i) {
+    if (i > 0) along_m += (points[i] - points[i - 1]).norm();
+    for (int k = 0; k <= sides; ++k) {  // k == sides duplicates k == 0 with u = repeats
+      const Vec3 nr = radial(i, 2 * std::numbers::pi * (k % sides) / sides);
+      ring[i].push_back(
+          vertex(points[i] + radii[i] * nr, nr, repeats * k / sides, along_m / repeat_m));
+    }
+  }
+  for (std::size_t i = 0; i + 1 < rings; ++i) {
+    for (int k = 0; k < sides; ++k) {
+      const Vec3 out = radial(i, 2 * std::numbers::pi * (k + 0.5) / sides);
+      triangle(ring[i][k], ring[i][k + 1], ring[i + 1][k + 1], out);
+      triangle(ring[i][k], ring[i + 1][k + 1], ring[i + 1][k], out);
+    }
+  }
+  if (!tip) return;
+  // Cone fan to the point: one apex vertex per side, its normal the side's mid radial.
+  const std::size_t last = rings - 1;
+  const double v_tip = (along_m + (points[n - 1] - points[n - 2]).norm()) / repeat_m;
+  for (int k = 0; k < sides; ++k) {
+    const Vec3 out = radial(last, 2 * std::numbers::pi * (k + 0.5) / sides);
+    const std::uint32_t apex = vertex(points[n - 1], out, repeats * (k + 0.5) / sides, v_tip);
+    triangle(ring[last][k], ring[last][k + 1], apex, out);
+  }
+}
+
+void MeshBuilder::card(const Vec3& centre, const Vec3& axis_u, const Vec3& axis_v,
+                       const Vec3& normal_hint) {
+  if (axis_u.cross(axis_v).squaredNorm() == 0) return;  // degenerate: nothing to draw
+  const std::uint32_t a = vertex(centre - axis_u - axis_v, normal_hint, 0, 0);
+  const std::uint32_t b = vertex(centre + axis_u - axis_v, normal_hint, 1, 0);
+  const std::uint32_t c = vertex(centre + axis_u + axis_v, normal_hint, 1, 1);
+  const std::uint32_t d = vertex(centre - axis_u + axis_v, normal_hint, 0, 1);
+  triangle(a, b, c, normal_hint);
+  triangle(a, c, d, normal_hint);
+}
+
+}  // namespace driftlab::scenes

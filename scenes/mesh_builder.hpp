@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -55,6 +56,20 @@ class MeshBuilder {
   /// (one repeat per repeat_m of circumference, rounded to whole repeats so the
   /// texture seam is invisible), v runs along it.
   void prism(const Vec3& a, const Vec3& b, double radius, int sides, double repeat_m);
+
+  /// Tube along the polyline `points` (>= 2) with one radius per point [m]: a ring of `sides`
+  /// vertices at every point, oriented by parallel-transport (rotation-minimising) frames (the
+  /// double reflection method of Wang et al. 2008) so the tube does not twist, smooth radial
+  /// normals, no caps. When the last radius is 0 (or tiny) the tube ends in a point (a cone fan).
+  /// u wraps around (whole repeats of repeat_m of circumference at the first ring, at least 1), v
+  /// runs along it in metres / repeat_m. Triangles: sides x 2 per segment, sides on a tip segment.
+  void tube(const std::vector<Vec3>& points, const std::vector<double>& radii, int sides,
+            double repeat_m);
+
+  /// One quad with corners centre -/+ axis_u -/+ axis_v, uv over [0, 1]^2 (u along axis_u, v
+  /// along axis_v), all four normals normal_hint (normalised), two triangles wound to face
+  /// normal_hint; no back copy (for double-sided materials such as leaf cards).
+  void card(const Vec3& centre, const Vec3& axis_u, const Vec3& axis_v, const Vec3& normal_hint);
 
   std::size_t vertex_count() const { return mesh_.vertices.size(); }
   std::size_t triangle_count() const { return mesh_.indices.size() / 3; }

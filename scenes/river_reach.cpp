@@ -1,10 +1,14 @@
 #include "scenes/river_reach.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <string>
+#include <tuple>
 
+#include <fmt/format.h>
 #include <Eigen/Geometry>
 
 #include "core/error.hpp"
@@ -15,6 +19,7 @@
 #include "scenes/photographs.hpp"
 #include "scenes/sky_clouds.hpp"
 #include "scenes/textures.hpp"
+#include "scenes/trees.hpp"
 
 namespace driftlab::scenes {
 
@@ -33,8 +38,9 @@ constexpr double kDeckDepth_m = 0.9;
 constexpr double kBridgeLandSpan_m = 12.0;  // abutment length behind the water's edge
 constexpr double kRampGrade = 0.15;
 constexpr double kQuayLength_m = 30.0;
-constexpr int kReedBlades = 14;        // blades per reed clump
-constexpr double kQuayPaving_m = 8.0;  // depth of the paved quay behind the wall
+constexpr int kReedBlades = 14;            // blades per reed clump
+constexpr double kQuayPaving_m = 8.0;      // depth of the paved quay behind the wall
+constexpr double kLeafGreyContrast = 0.3;  // relative spread of the leaves' grey in a cluster
 
 // Cross-section of one bank, from the options.
 struct Bank {
@@ -107,6 +113,7 @@ sim::Material solid(int texture, float albedo) {
 
 struct Textures {
   int grass, soil, bark, foliage, reeds, concrete, sheet, facade, roof, brick, stone;
+  int leaves_broad, leaves_narrow;  // leaf-cluster cards (alpha), at the foliage's mean grey
 };
 
 // The procedural textures, or where options.photographs asks for them the photographs of the
@@ -137,6 +144,14 @@ Textures add_textures(sim::SceneGeometry* g, std::uint64_t seed, const RiverReac
   t.roof = add(TextureKind::kRoof);
   t.brick = add(TextureKind::kBrick);
   t.stone = add(TextureKind::kStone);
+  const double foliage_grey = mean_gray(g->textures[static_cast<std::size_t>(t.foliage)]);
+  for (const auto& [shape, index, name] :
+       {std::tuple{LeafShape::kBroad, &t.leaves_broad, "broad"},
+        std::tuple{LeafShape::kNarrow, &t.leaves_narrow, "narrow"}}) {
+    Rng r = streams.stream(fmt::format("scene.texture.leaves_{}", name));
+    *index = static_cast<int>(g->textures.size());
+    g->textures.push_back(make_leaf_cluster(shape, &r, foliage_grey, kLeafGreyContrast));
+  }
   return t;
 }
 
@@ -569,8 +584,44 @@ std::vector<BuildingSpec> plan_buildings(const RiverReachOptions& o, const Bank&
 // Trees: two rows per bank, the first at the tree line. Every candidate
 // draws the same numbers whether or not it is kept, so removing one (for the
 // bridge, the quay, a building) does not move the others.
+// A tree's species, lean and form seed, from a stream of its own (so that the tile's stream, and
+// with it every position and size, is the same for either tree model). The mix: willows by the
+// water, alders and poplars behind them (species of lowland river banks in Britain).
+void choose_form(TreeSpec* t, const RngStreams& streams, const RiverTileLayout& L, int side,
+                 int row, int i) {
+  Rng r = streams.stream(fmt::format("scene.river.tile.{}.tree.{}.{}.{}", L.index,
+                                     side > 0 ? "east" : "west", row, i));
+  constexpr std::array<std::array<double, 4>, 2> kMix{{
+      {0.40, 0.35, 0.15, 0.10},  // row 0: alder, willow, weeping willow, poplar
+      {0.45, 0.20, 0.00, 0.35},  // row 1
+  }};
+  const double u = r.uniform();
+  double acc = 0;
+  int species = 3;
+  for (int sp = 0; sp < 4; ++sp) {
+    acc += kMix[static_cast<std::size_t>(row)][static_cast<std::size_t>(sp)];
+    if (u < acc) {
+      species = sp;
+      break;
+    }
+  }
+  t->species = static_cast<TreeSpecies>(species);
+  const bool willow =
+      t->species == TreeSpecies::kWillow || t->species == TreeSpecies::kWeepingWillow;
+  const double lean_deg = r.uniform(0.0, 1.0), azimuth = r.uniform(0.0, 2 * kPi);
+  if (willow && row == 0) {  // willows by the water lean over it
+    t->lean_rad = (8.0 + 17.0 * lean_deg) * kPi / 180.0;
+    t->lean_dir_W = Vec3(0, -side, 0);
+  } else {
+    t->lean_rad = 5.0 * lean_deg * kPi / 180.0;
+    t->lean_dir_W = Vec3(std::cos(azimuth), std::sin(azimuth), 0);
+  }
+  t->form_seed = r.next_u64();
+}
+
 std::vector<TreeSpec> plan_trees(const RiverReachOptions& o, const Bank& k, const Noise& n,
-                                 const RiverTileLayout& L, Rng* rng) {
+                                 const RiverTileLayout& L, std::uint64_t seed, Rng* rng) {
+  const RngStreams streams(seed);
   std::vector<TreeSpec> trees;
   if (!(o.vegetation_density > 0)) return trees;
   const double len = o.reach_length_m;
@@ -591,6 +642,8 @@ std::vector<TreeSpec> plan_trees(const RiverReachOptions& o, const Bank& k, cons
         const double s =
             std::max(o.tree_line_distance_m + row * kTreeRowGap_m + ds, t.trunk_radius_m + 0.3);
         const double y = side * (k.b + s);
+        choose_form(&t, streams, L, side, row, i);
+        t.lod = s <= o.tree_detail_distance_m ? 0 : 1;
         if (L.bridge && std::abs(x - L.bridge_x_m) < L.bridge_half_width_m + 3.0 &&
             s < kBridgeLandSpan_m + 25.0)
           continue;
@@ -628,6 +681,95 @@ std::vector<TreeSpec> plan_bushes(const RiverReachOptions& o, const Bank& k, con
   return bushes;
 }
 
+// The trees of earlier rounds: a 6-sided trunk under a lumpy ellipsoid (tree_model: ellipsoid).
+void add_ellipsoid_trees(sim::SceneGeometry* g, const RiverTileLayout& L, const Textures& tex,
+                         Rng* lumps) {
+  MeshBuilder trunks(tile_name(L.index, "tree_trunks"), solid(tex.bark, 0.7f));
+  MeshBuilder crowns(tile_name(L.index, "tree_crowns"), solid(tex.foliage, 0.8f));
+  for (const TreeSpec& t : L.trees) {
+    const double z_crown_centre = t.base_W.z() - (1.0 - kCrownAxisFrac) * t.height_m;
+    trunks.prism(t.base_W + Vec3(0, 0, 0.3), Vec3(t.base_W.x(), t.base_W.y(), z_crown_centre),
+                 t.trunk_radius_m, 6, 1.5);
+    add_crown(&crowns, t, kCrownAxisFrac, lumps);
+  }
+  add_mesh(g, trunks.take());
+  add_mesh(g, crowns.take());
+}
+
+// Whether a tree keeps the boats' water clear: nothing nearer the centre line than
+// b - min(2 m, b / 5), nothing over the water lower than 1.5 m above it.
+bool clear_of_the_water(const sim::Mesh& m, const Bank& k) {
+  const double nearest = k.b - std::min(2.0, 0.2 * k.b);
+  for (const sim::Vertex& v : m.vertices) {
+    const double y = std::abs(static_cast<double>(v.y));
+    if (y < nearest || (y < k.b && v.z > -1.5)) return false;
+  }
+  return true;
+}
+
+// One skeleton tree's wood and leaves, its lean halved until it keeps the water clear (at no
+// lean it stands as planted).
+std::pair<sim::Mesh, sim::Mesh> grow_and_dress(const TreeSpec& t, const Bank& k,
+                                               const Textures& tex, int cards) {
+  TreeForm f{t.base_W,  t.height_m, t.crown_radius_m, t.trunk_radius_m,
+             t.species, t.lod,      t.lean_dir_W,     t.lean_rad};
+  const int leaves_tex =
+      leaf_shape_of(t.species) == LeafShape::kBroad ? tex.leaves_broad : tex.leaves_narrow;
+  for (int attempt = 0;; ++attempt) {
+    Rng rng(t.form_seed);
+    MeshBuilder wood("wood", solid(tex.bark, 0.7f)), leaves("leaves", material(leaves_tex, 0.8f));
+    dress_tree(f, grow_tree(f, &rng), cards, &rng, &wood, &leaves);
+    sim::Mesh w = wood.take(), l = leaves.take();
+    if (f.lean_rad == 0 || (clear_of_the_water(w, k) && clear_of_the_water(l, k)))
+      return {std::move(w), std::move(l)};
+    f.lean_rad = attempt < 3 ? 0.5 * f.lean_rad : 0.0;
+  }
+}
+
+// A bush as a skeleton (willow or alder scrub branching low), from a stream of its own.
+TreeSpec scrub(const TreeSpec& bush, std::uint64_t seed, int tile, std::size_t i) {
+  Rng r = RngStreams(seed).stream(fmt::format("scene.river.tile.{}.bush.{}", tile, i));
+  TreeSpec t = bush;
+  t.species = r.uniform() < 0.6 ? TreeSpecies::kWillow : TreeSpecies::kAlder;
+  t.trunk_radius_m = 0.03 + 0.01 * t.height_m;
+  t.lod = 0;
+  t.lean_rad = 0;
+  t.form_seed = r.next_u64();
+  return t;
+}
+
+// Skeleton trees (scenes/trees.hpp) and scrub, gathered per bank and per 50 m of river into one
+// wood and one leaf mesh per leaf shape: the renderer culls them by those chunks.
+void add_skeleton_trees(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k,
+                        const Textures& tex, const RiverReachOptions& o, std::uint64_t seed) {
+  constexpr double kChunk_m = 50.0;
+  std::map<std::tuple<int, long long, int>, sim::Mesh> chunks;  // side, chunk, part
+  const auto chunk = [&](const TreeSpec& t, int part, const sim::Mesh& m) -> sim::Mesh& {
+    const int side = t.base_W.y() > 0 ? 1 : -1;
+    const auto c = static_cast<long long>(std::floor(t.base_W.x() / kChunk_m));
+    const auto [it, fresh] = chunks.try_emplace({side, c, part});
+    if (fresh) {
+      static constexpr std::array<const char*, 6> kPart{
+          "tree_wood",   "tree_leaves_broad",   "tree_leaves_narrow",
+          "bushes_wood", "bushes_leaves_broad", "bushes_leaves_narrow"};
+      it->second.name = fmt::format("tile{}.{}_{}{}", L.index,
+                                    kPart[static_cast<std::size_t>(part)], side > 0 ? "e" : "w", c);
+      it->second.material = m.material;
+    }
+    return it->second;
+  };
+  const auto add = [&](const TreeSpec& t, int cards, int first_part) {
+    const auto [wood, leaves] = grow_and_dress(t, k, tex, cards);
+    append_mesh(&chunk(t, first_part, wood), wood, Vec3::Zero());
+    const int part = first_part + (leaf_shape_of(t.species) == LeafShape::kBroad ? 1 : 2);
+    append_mesh(&chunk(t, part, leaves), leaves, Vec3::Zero());
+  };
+  for (const TreeSpec& t : L.trees) add(t, o.leaf_cards_per_tree, 0);
+  for (std::size_t i = 0; i < L.bushes.size(); ++i)
+    add(scrub(L.bushes[i], seed, L.index, i), std::max(8, o.leaf_cards_per_tree / 3), 3);
+  for (auto& [key, m] : chunks) add_mesh(g, std::move(m));
+}
+
 }  // namespace
 
 double river_terrain_z(const RiverReachOptions& options, std::uint64_t seed, double x_m,
@@ -645,7 +787,7 @@ RiverTileLayout plan_river_tile(const RiverReachOptions& o, std::uint64_t seed, 
   L.bollards_W = plan_bollards(L, k, n);
   // One stream in this order: buildings, trees, bushes.
   L.buildings = plan_buildings(o, k, n, L, &rng);
-  L.trees = plan_trees(o, k, n, L, &rng);
+  L.trees = plan_trees(o, k, n, L, seed, &rng);
   L.bushes = plan_bushes(o, k, n, L, &rng);
   return L;
 }
@@ -709,20 +851,15 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
     const RiverTileLayout L = plan_river_tile(options, seed, index);
     for (int side : {1, -1}) add_terrain(&g, L, k, n, tex, side);
 
-    MeshBuilder trunks(tile_name(index, "tree_trunks"), solid(tex.bark, 0.7f));
-    MeshBuilder crowns(tile_name(index, "tree_crowns"), solid(tex.foliage, 0.8f));
     Rng lumps = RngStreams(seed).stream("scene.river.tile." + std::to_string(index) + ".crowns");
-    for (const TreeSpec& t : L.trees) {
-      const double z_crown_centre = t.base_W.z() - (1.0 - kCrownAxisFrac) * t.height_m;
-      trunks.prism(t.base_W + Vec3(0, 0, 0.3), Vec3(t.base_W.x(), t.base_W.y(), z_crown_centre),
-                   t.trunk_radius_m, 6, 1.5);
-      add_crown(&crowns, t, kCrownAxisFrac, &lumps);
+    if (options.tree_model == TreeModel::kSkeleton) {
+      add_skeleton_trees(&g, L, k, tex, options, seed);
+    } else {
+      add_ellipsoid_trees(&g, L, tex, &lumps);
+      MeshBuilder bushes(tile_name(index, "bushes"), solid(tex.foliage, 0.8f));
+      for (const TreeSpec& t : L.bushes) add_crown(&bushes, t, 0.5, &lumps);
+      add_mesh(&g, bushes.take());
     }
-    add_mesh(&g, trunks.take());
-    add_mesh(&g, crowns.take());
-    MeshBuilder bushes(tile_name(index, "bushes"), solid(tex.foliage, 0.8f));
-    for (const TreeSpec& t : L.bushes) add_crown(&bushes, t, 0.5, &lumps);
-    add_mesh(&g, bushes.take());
 
     // Reeds: clumps of thin two-sided blades (single triangles, so the tops
     // are ragged without alpha textures) straddling the water's edge, fewer

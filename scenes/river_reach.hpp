@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "scenes/scene_options.hpp"
+#include "scenes/trees.hpp"
 #include "sim/render/scene_geometry.hpp"
 
 namespace driftlab::scenes {
@@ -27,12 +28,20 @@ constexpr double kTreeHeightMax = 1.25;
 constexpr double kFarFieldStart_m = 60.0;
 constexpr double kFarFieldEnd_m = 150.0;
 
-/// One tree: base on the ground (NED), height above the base, crown radius.
+/// One tree: base on the ground (NED), height above the base, crown radius; for skeleton trees
+/// (scenes/trees.hpp) its species, level of detail, the lean asked for (build_river_reach takes
+/// less where the tree would come nearer the boats' water than the bank allows) and the seed of
+/// its form.
 struct TreeSpec {
   Eigen::Vector3d base_W;
   double height_m = 0;
   double crown_radius_m = 0;
   double trunk_radius_m = 0;
+  TreeSpecies species = TreeSpecies::kAlder;
+  int lod = 0;  // 0 near (twigs, all cards), 1 mid
+  Eigen::Vector3d lean_dir_W = Eigen::Vector3d::UnitX();
+  double lean_rad = 0;
+  std::uint64_t form_seed = 0;
 };
 
 /// A building: footprint [x0, x1] x [y0, y1], ground (lowest wall foot) and eave heights (NED z).

@@ -17,6 +17,12 @@ constexpr auto enum_table(SceneType) {
                     std::pair{SceneType::kWaveBasin, "wave_basin"}};
 }
 
+enum class TreeModel { kSkeleton, kEllipsoid };
+constexpr auto enum_table(TreeModel) {
+  return std::array{std::pair{TreeModel::kSkeleton, "skeleton"},
+                    std::pair{TreeModel::kEllipsoid, "ellipsoid"}};
+}
+
 enum class Sky { kOvercast, kSun };
 constexpr auto enum_table(Sky) {
   return std::array{std::pair{Sky::kOvercast, "overcast"}, std::pair{Sky::kSun, "sun"}};
@@ -31,6 +37,9 @@ struct RiverReachOptions {
   double tree_line_distance_m = 4.0;
   double tree_height_m = 12.0;
   double vegetation_density = 0.6;
+  TreeModel tree_model = TreeModel::kSkeleton;
+  int leaf_cards_per_tree = 90;
+  double tree_detail_distance_m = 7.0;
   double texture_contrast = 2.0;
   bool photographs = true;
   double cloud_contrast = 0.08;
@@ -85,6 +94,19 @@ struct RiverReachOptions {
     a("vegetation_density", vegetation_density,
       "Trees and reeds per unit bank (0 = bare, 1 = a tree every 4 m in each of two rows)",
       yaml::unit_interval());
+    a("tree_model", tree_model,
+      "skeleton: alders, willows (leaning over the water), weeping willows and poplars grown "
+      "as trunks, limbs and twigs (Weber and Penn 1995) in photographed bark, dressed with "
+      "alpha-tested leaf-cluster cards (docs/renderer-and-scenes.md, Trees); ellipsoid: a "
+      "6-sided trunk under a lumpy ellipsoid, the cheaper crowns of earlier rounds");
+    a("leaf_cards_per_tree", leaf_cards_per_tree,
+      "Leaf-cluster cards on a near tree (half as many, each twice the area, at the mid level "
+      "of detail); skeleton trees only",
+      yaml::in_range(8, 400));
+    a("tree_detail_distance_m", tree_detail_distance_m,
+      "Trees at most this far behind the water's edge get twigs and the full set of cards; "
+      "those further back three-sided limbs and half the cards (skeleton trees only)",
+      yaml::non_negative() & yaml::up_to(1000, "trees further away are not scenery a VO sees"));
     a("texture_contrast", texture_contrast,
       "Contrast of procedural textures: scales each texture's deviation from its mean grey, "
       "clamped to [0, 255]. 2 gives frames whose spectrum slope, gradients and corners per "

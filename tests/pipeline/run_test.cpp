@@ -393,8 +393,11 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   // same day: 0.0042 and 0.0467 m/m; procedural textures everywhere, 2026-11-26: 0.0045 and
   // 0.0338 m/m). Two sections make sparse_kf's figure noisy: over seeds 1-3 of a similar leg it
   // was 0.0071, 0.0043, 0.0052 with the new sky and 0.0032, 0.0032, 0.0068 with the flat one,
-  // and the CI gate's 80 paired sections saw no change (+2.9 %, p = 0.39). The bounds sit about
-  // 30 % above, so a 30 % regression of either VO or of the renderer fails.
+  // and the CI gate's 80 paired sections saw no change (+2.9 %, p = 0.39). With the skeleton
+  // trees and their alpha-tested leaf cards (2026-11-29, the same day): sparse_kf 0.0130 m/m,
+  // length -0.4 %, 3D RMSE 0.55 %; sparse 0.0508 m/m, length -2.8 % (features on leaf edges
+  // against the sky through the crowns' gaps). The bounds sit about 30 % above the latest
+  // figures, so a 30 % regression of either VO or of the renderer fails.
   auto mean_ep = [&](const char* algo) {
     return m["algorithms"][algo]["sections"]["p_m_per_m"]["mean"].get<double>();
   };
@@ -407,10 +410,10 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
       "3D RMSE %.2f %%\n",
       mean_ep("sparse"), length_error_pct("sparse"), mean_ep("sparse_kf"),
       length_error_pct("sparse_kf"), kf["track"]["rmse_3d_pct"].get<double>());
-  EXPECT_LT(mean_ep("sparse_kf"), 0.0091);
+  EXPECT_LT(mean_ep("sparse_kf"), 0.0169);
   EXPECT_GT(mean_ep("sparse_kf"), 0.0);
   EXPECT_LT(std::abs(length_error_pct("sparse_kf")), 3.0);  // the twin-fidelity issue's +-3 %
-  EXPECT_LT(kf["track"]["rmse_3d_pct"].get<double>(), 0.50);
+  EXPECT_LT(kf["track"]["rmse_3d_pct"].get<double>(), 0.72);
   EXPECT_LT(mean_ep("sparse"), 0.061);
   EXPECT_GT(mean_ep("sparse"), 0.0);
   EXPECT_LT(std::abs(length_error_pct("sparse")), 3.4);

@@ -371,8 +371,8 @@ TEST(RiverReach, SameSeedSameSceneOtherSeedOtherScene) {
   ASSERT_EQ(a.textures.size(), b.textures.size());
   for (std::size_t i = 0; i < a.textures.size(); ++i)
     EXPECT_EQ(a.textures[i].pixels, b.textures[i].pixels);
-  const auto* ta = find_mesh(a, "tile0.tree_crowns");
-  const auto* tc = find_mesh(c, "tile0.tree_crowns");
+  const auto* ta = find_mesh(a, "tile0.tree_leaves_broad_e0");
+  const auto* tc = find_mesh(c, "tile0.tree_leaves_broad_e0");
   ASSERT_TRUE(ta && tc);
   EXPECT_NE(ta->vertices.size() == tc->vertices.size() &&
                 0 == std::memcmp(ta->vertices.data(), tc->vertices.data(),
@@ -424,10 +424,14 @@ TEST(RiverReach, WaterEdgeAtTheConfiguredBankDistance) {
     int above = 0, terrain_vertices_at_edge = 0;
     for (const auto& m : g.meshes) {
       const bool may_overhang = name_has(m, "bridge") || name_has(m, "quay") ||
-                                name_has(m, "reeds") || name_has(m, "tree_crowns") ||
+                                name_has(m, "reeds") || name_has(m, "tree_") ||
                                 name_has(m, "bushes") || name_has(m, "river_bend");
       const bool terrain = name_has(m, "bank_") || name_has(m, "plain_");
       for (const auto& v : m.vertices) {
+        // Trees may lean over the water, but keep the boats' part of it clear.
+        if (name_has(m, "tree_")) {
+          EXPECT_GE(std::abs(v.y), bank - std::min(2.0, 0.2 * bank)) << m.name;
+        }
         if (std::abs(v.y) < bank - 1e-4 && v.z < -0.01 && !may_overhang) {
           ++above;
           ADD_FAILURE() << m.name << " vertex at y " << v.y << " z " << v.z << " (bank " << bank
@@ -470,17 +474,26 @@ TEST(RiverReach, TreeHeightsWithinTheConfiguredRange) {
     EXPECT_GT(hi, 1.15 * h);
     // The geometry has each tree's apex at its planned height, and nothing higher.
     const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
-    const auto* crowns = find_mesh(g, "tile0.tree_crowns");
-    ASSERT_TRUE(crowns);
+    // Each trunk's top at its planned height (leaning trees: within their lean, at most 25 deg,
+    // of the base), and nothing higher than the highest top.
+    std::vector<const sim::Mesh*> trees;
+    for (const auto& m : g.meshes)
+      if (m.name.rfind("tile0.tree_", 0) == 0) trees.push_back(&m);
+    ASSERT_GE(trees.size(), 4u);
+    double highest = 0;
     for (const auto& t : L.trees) {
-      const Vec3 apex = t.base_W - Vec3(0, 0, t.height_m);
+      const double apex_z = t.base_W.z() - t.height_m;
+      highest = std::min(highest, apex_z);
       bool found = false;
-      for (const auto& v : crowns->vertices) found = found || (pos(v) - apex).norm() < 1e-3;
+      for (const auto* m : trees)
+        for (const auto& v : m->vertices)
+          found = found || (std::abs(v.z - apex_z) < 1e-3 &&
+                            (pos(v) - t.base_W).head<2>().norm() < 0.47 * t.height_m);
       EXPECT_TRUE(found) << "apex of the tree at x " << t.base_W.x();
     }
-    double top = 0;
-    for (const auto& v : crowns->vertices) top = std::min(top, double(v.z));
-    EXPECT_GT(top, -(1.25 * h + o.bank_height_m + 2.0));
+    for (const auto* m : trees)
+      for (const auto& v : m->vertices) ASSERT_GE(v.z, highest - 1e-4) << m->name;
+    EXPECT_GT(highest, -(1.25 * h + o.bank_height_m + 2.0));
   }
 }
 
@@ -488,7 +501,7 @@ TEST(RiverReach, VegetationDensityZeroIsBare) {
   RiverReachOptions o = river_defaults();
   o.vegetation_density = 0;
   const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
-  EXPECT_FALSE(find_mesh(g, "tile0.tree_crowns"));
+  for (const auto& m : g.meshes) EXPECT_FALSE(name_has(m, "tree_")) << m.name;
   EXPECT_FALSE(find_mesh(g, "tile0.reeds"));
   EXPECT_FALSE(find_mesh(g, "tile0.bushes"));
   o.vegetation_density = 1.0;
@@ -590,7 +603,9 @@ TEST(RiverReach, FeatureDepthsLikeRiverPaperTable4) {
   EXPECT_GE(c.p10, 4.0);
   EXPECT_LE(c.p10, 15.0);
   EXPECT_GE(c.p90, 30.0);
-  EXPECT_LE(c.p90, 55.0);
+  // 60: rays through the skeleton trees' crowns reach the wood beyond (62 m and more): p90
+  // 57.3 m (was 41 under the ellipsoid crowns, 54 under the first, smaller leaf cards).
+  EXPECT_LE(c.p90, 60.0);
   // Off-centre (the crossings of the river_crossing scenario run to 3.25 m
   // from the banks) the near end reaches the paper's ~4 m.
   const DepthStats off = feature_depths(rc, {{0, 6, -0.5}, {30, -6, -0.5}}, headings);
