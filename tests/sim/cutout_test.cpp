@@ -13,6 +13,7 @@
 #include "core/rotation.hpp"
 #include "sim/render/alpha_mips.hpp"
 #include "sim/render/renderer.hpp"
+#include "tests/sim/render_fixtures.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {
@@ -124,15 +125,6 @@ TEST(AlphaMips, OpaqueGreyIsTheBlockMeanAndRepeatable) {
 // ---------------------------------------------------------------------------
 // The renderer.
 
-SE3 camera_north_at(const Vec3& p) { return SE3(R_frd_optical(), p); }
-
-StereoRig card_rig() {
-  StereoRig rig;
-  rig.camera = PinholeCamera{};  // 640x480, fx = fy = 500, cx = 319.5, cy = 239.5
-  rig.baseline_m = 0.12;
-  return rig;
-}
-
 // A vertical quad facing south (towards cameras looking north) at north x, spanning east
 // [y0, y1] and down [z0, z1]; uv (0, 0) at (y0, z0), (1, 1) at (y1, z1).
 Mesh card(double x, double y0, double y1, double z0, double z1, int texture) {
@@ -149,17 +141,6 @@ Mesh card(double x, double y0, double y1, double z0, double z1, int texture) {
   return m;
 }
 
-// Unlit, black sky: a white texel saturates to 255, nothing else is drawn.
-SceneGeometry unlit_scene() {
-  SceneGeometry s;
-  s.lighting.ambient = 2.0f;
-  s.lighting.diffuse = 0.0f;
-  s.lighting.sky_brightness = 0.0f;
-  s.lighting.fog_distance_m = 1e9f;
-  s.water.enabled = false;
-  return s;
-}
-
 int bright_pixels(const GrayImage& img) {
   int n = 0;
   for (std::uint8_t p : img.pixels) n += p > 127;
@@ -170,13 +151,13 @@ TEST(Cutout, ACardCoversWhatItsTextureCoversAtEveryDistance) {
   // A 5.12 m card of 256 texels: 1, 2, 4 and 8 texels a pixel at 10, 20, 40 and 80 m.
   const Texture t = speckle_texture(256);
   const double c0 = alpha_coverage(t.alpha);
-  StereoRenderer renderer(card_rig(), RenderOptions{});
+  StereoRenderer renderer(fixtures::rig_640(), RenderOptions{});
   for (double d : {10.0, 20.0, 40.0, 80.0}) {
-    SceneGeometry s = unlit_scene();
+    SceneGeometry s = fixtures::dark_scene();
     s.textures.push_back(t);
     s.meshes.push_back(card(d, -2.56, 2.56, -2.56, 2.56, 0));
     renderer.upload(s);
-    const StereoImages img = renderer.render(camera_north_at(Vec3::Zero()), 0.0, false);
+    const StereoImages img = renderer.render(fixtures::camera_at(Vec3::Zero()), 0.0, false);
     const double side_px = 500 * 5.12 / d;
     const double covered = bright_pixels(img.left) / (side_px * side_px);
     EXPECT_NEAR(covered, c0, 0.02) << d << " m";
@@ -197,10 +178,10 @@ TEST(Cutout, ACardLooksLikeTheGeometryItsAlphaCovers) {
     std::fill(white.pixels.begin(), white.pixels.end(), std::uint8_t{255});
     s.textures = {half, white};
     s.meshes = {m};
-    StereoRenderer renderer(card_rig(), RenderOptions{});
+    StereoRenderer renderer(fixtures::rig_640(), RenderOptions{});
     renderer.upload(s);
     renderer.set_waves({});
-    return renderer.render(camera_north_at(Vec3(0, 0.3, -1.0)), 0.0, true);
+    return renderer.render(fixtures::camera_at(Vec3(0, 0.3, -1.0)), 0.0, true);
   };
   const StereoImages cut = render(card(8, -1.5, 1.5, -3.0, -1.0, 0));
   const StereoImages geo = render(card(8, -1.5, 1.5, -3.0, -2.0, 1));  // texels are white there
@@ -213,7 +194,7 @@ TEST(Cutout, ACardLooksLikeTheGeometryItsAlphaCovers) {
       shown += std::abs(b->pixels[i] - none.left.pixels[i]) > 8;
     }
     EXPECT_GT(shown, 0.9 * card_px);  // the half (and its dim mirror image) is drawn
-    EXPECT_LT(differ, 2 * 2 * 190);  // at most two rows along the cut, direct and mirrored
+    EXPECT_LT(differ, 2 * 2 * 190);   // at most two rows along the cut, direct and mirrored
   }
   int depth_differ = 0;
   for (std::size_t i = 0; i < cut.depth_left.depth_m.size(); ++i)
@@ -223,12 +204,12 @@ TEST(Cutout, ACardLooksLikeTheGeometryItsAlphaCovers) {
 
 TEST(Cutout, DepthShowsExactlyTheColourImagesHoles) {
   const Texture t = speckle_texture(256);
-  SceneGeometry s = unlit_scene();
+  SceneGeometry s = fixtures::dark_scene();
   s.textures.push_back(t);
   s.meshes.push_back(card(15, -2.56, 2.56, -2.56, 2.56, 0));
-  StereoRenderer renderer(card_rig(), RenderOptions{});
+  StereoRenderer renderer(fixtures::rig_640(), RenderOptions{});
   renderer.upload(s);
-  const StereoImages a = renderer.render(camera_north_at(Vec3::Zero()), 0.0, true);
+  const StereoImages a = renderer.render(fixtures::camera_at(Vec3::Zero()), 0.0, true);
   int mismatched = 0, drawn = 0, off_plane = 0;
   for (std::size_t i = 0; i < a.left.pixels.size(); ++i) {
     const bool colour = a.left.pixels[i] > 127, depth = a.depth_left.depth_m[i] > 0;
@@ -239,7 +220,7 @@ TEST(Cutout, DepthShowsExactlyTheColourImagesHoles) {
   EXPECT_GT(drawn, 5000);
   EXPECT_EQ(mismatched, 0);
   EXPECT_EQ(off_plane, 0);
-  const StereoImages b = renderer.render(camera_north_at(Vec3::Zero()), 0.0, true);
+  const StereoImages b = renderer.render(fixtures::camera_at(Vec3::Zero()), 0.0, true);
   EXPECT_EQ(a.left.pixels, b.left.pixels);
   EXPECT_EQ(a.right.pixels, b.right.pixels);
 }

@@ -16,31 +16,15 @@
 #include "core/rotation.hpp"
 #include "sim/render/mip_chain.hpp"
 #include "sim/waves/wave_field.hpp"
+#include "tests/sim/render_fixtures.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {
 namespace {
 
-// A camera looking north, level: optical axes = body FRD axes of a vessel heading north.
-SE3 camera_at(const Vec3& p) { return SE3(R_frd_optical(), p); }
-
-StereoRig rig_640() {
-  StereoRig rig;
-  rig.camera = PinholeCamera{};  // 640x480, fx = fy = 500, cx = 319.5, cy = 239.5
-  rig.baseline_m = 0.12;
-  return rig;
-}
-
-// Unlit, black-sky scene for geometric tests.
-SceneGeometry dark_scene() {
-  SceneGeometry s;
-  s.lighting.ambient = 2.0f;  // a vertical surface saturates to white
-  s.lighting.diffuse = 0.0f;
-  s.lighting.sky_brightness = 0.0f;
-  s.lighting.fog_distance_m = 1e9f;
-  s.water.enabled = false;
-  return s;
-}
+using fixtures::camera_at;
+using fixtures::dark_scene;
+using fixtures::rig_640;
 
 // A disc of `radius` facing north (towards a camera south of it), centred at c.
 Mesh disc(const Vec3& c, double radius, int segments = 64) {
