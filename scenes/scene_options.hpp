@@ -38,7 +38,7 @@ struct RiverReachOptions {
   double tree_height_m = 12.0;
   double vegetation_density = 0.6;
   TreeModel tree_model = TreeModel::kSkeleton;
-  int leaf_cards_per_tree = 90;
+  int leaf_cards_per_tree = 60;
   double tree_detail_distance_m = 7.0;
   double texture_contrast = 2.0;
   bool photographs = true;

@@ -276,7 +276,7 @@ TreeSkeleton grow_tree(const TreeForm& f, Rng* rng) {
 int tree_triangle_count(const TreeSkeleton& s, int lod, int cards) {
   int n = 0;
   for (const Stem& st : s.stems)
-    n += st.level == 0 ? (lod == 0 ? 54 : 25) : st.level == 1 ? (lod == 0 ? 20 : 9) : 3;
+    n += st.level == 0 ? (lod == 0 ? 54 : 25) : st.level == 1 ? (lod == 0 ? 20 : 9) : 0;
   return n + 2 * card_count(cards, lod);
 }
 
@@ -351,10 +351,12 @@ Card make_card(const TreeForm& f, const Vec3& at, const Vec3& crown_c, const Vec
 void dress_tree(const TreeForm& f, const TreeSkeleton& s, int cards, Rng* rng, MeshBuilder* wood,
                 MeshBuilder* leaves) {
   DRIFTLAB_DEMAND_MSG(!s.stems.empty() && cards >= 0, "dress_tree needs a skeleton");
+  // Twigs carry cards but are not drawn as wood: the leaf-cluster texture draws them, and
+  // tubes a centimetre or two thick are a tenth of a pixel from the water, where a rasteriser
+  // without anti-aliasing turns them into dotted lines that flicker from frame to frame.
   for (const Stem& st : s.stems) {
-    const int sides = st.level == 0   ? (f.lod == 0 ? 6 : 5)
-                      : st.level == 1 ? (f.lod == 0 ? 4 : 3)
-                                      : 3;
+    if (st.level >= 2) continue;
+    const int sides = st.level == 0 ? (f.lod == 0 ? 6 : 5) : (f.lod == 0 ? 4 : 3);
     wood->tube(st.points, st.radii, sides, kBarkRepeat_m);
   }
   // The crown's centre: the mean of the limbs' and twigs' points.

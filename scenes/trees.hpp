@@ -94,7 +94,8 @@ TreeSkeleton grow_tree(const TreeForm& f, Rng* rng);
 inline int card_count(int cards, int lod) { return lod == 0 ? cards : cards / 2; }
 
 /// Triangles dress_tree adds for a skeleton: wood (trunk 6 sides x 5 segments = 54 at lod 0,
-/// 5 x 3 = 25 at lod 1; limbs 4 x 3 = 20 / 3 x 2 = 9; twigs 3-sided cones = 3) plus 2 per card.
+/// 5 x 3 = 25 at lod 1; limbs 4 x 3 = 20 / 3 x 2 = 9; twigs none: the card texture draws them) plus
+/// 2 per card.
 int tree_triangle_count(const TreeSkeleton& s, int lod, int cards);
 
 /// Bark tubes (one repeat of the bark texture per 1.5 m of circumference) into `wood`; leaf cards

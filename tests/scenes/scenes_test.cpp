@@ -604,7 +604,7 @@ TEST(RiverReach, FeatureDepthsLikeRiverPaperTable4) {
   EXPECT_LE(c.p10, 15.0);
   EXPECT_GE(c.p90, 30.0);
   // 60: rays through the skeleton trees' crowns reach the wood beyond (62 m and more): p90
-  // 57.3 m (was 41 under the ellipsoid crowns, 54 under the first, smaller leaf cards).
+  // 57.4 m (was 41 under the ellipsoid crowns).
   EXPECT_LE(c.p90, 60.0);
   // Off-centre (the crossings of the river_crossing scenario run to 3.25 m
   // from the banks) the near end reaches the paper's ~4 m.
