@@ -21,8 +21,14 @@ GateCommand::GateCommand(CLI::App* cmd) : cmd_(cmd) {
   cmd_->add_option("--results", results_,
                    "Run folder, merged sweep folder, or a metrics.json; required");
   cmd_->add_option("--junit", junit_, "Also write the verdicts as JUnit XML here");
-  cmd_->add_flag("--update", update_,
-                 "Write the new values into the baseline (accept them) instead of failing");
+  CLI::Option* update =
+      cmd_->add_flag("--update", update_,
+                     "Write the new values into the baseline (accept them) instead of failing");
+  cmd_->add_option("--only", only_,
+                   "Check only the baseline's metrics whose key starts with one of these "
+                   "(comma-separated, e.g. algorithms.sparse.); the others are not compared")
+      ->delimiter(',')
+      ->excludes(update);
   init_ = cmd_->add_subcommand("init", "Write a new baseline from a run or a merged sweep");
   init_->add_option("--results", init_results_, "Run folder, merged sweep folder, or metrics.json")
       ->required();
@@ -83,7 +89,8 @@ int GateCommand::run() {
         fmt::format("{}: no such baseline; create one from results with `driftlab "
                     "regress init --results DIR --baseline {}`",
                     baseline_, baseline_));
-  const gate::Baseline baseline = gate::load_baseline(baseline_);
+  gate::Baseline baseline = gate::load_baseline(baseline_);
+  if (!only_.empty()) baseline = gate::only_metrics(std::move(baseline), only_);
   const fs::path file = gate::find_results_metrics(results_);
   const nlohmann::json results = gate::read_results_metrics(file);
   const gate::GateResult r = gate::check_baseline(baseline, results, file);

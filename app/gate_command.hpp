@@ -31,6 +31,7 @@ class GateCommand {
   std::string schema_out_;
   std::string baseline_, results_, junit_;
   bool update_ = false;
+  std::vector<std::string> only_;  // --only: key prefixes
   std::string init_results_, init_baseline_, description_;
   std::vector<std::string> keys_;
   double rel_tol_ = 0.1;

@@ -1,6 +1,7 @@
 #include "gate/gate.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
@@ -398,6 +399,18 @@ std::string GateResult::junit_xml() const {
   x += "    <system-out>" + markup_escape(table()) + "</system-out>\n";
   x += "  </testsuite>\n</testsuites>\n";
   return x;
+}
+
+Baseline only_metrics(Baseline baseline, const std::vector<std::string>& prefixes) {
+  const auto wanted = [&](const BaselineMetric& m) {
+    return std::any_of(prefixes.begin(), prefixes.end(),
+                       [&](const std::string& p) { return m.key.rfind(p, 0) == 0; });
+  };
+  std::erase_if(baseline.metrics, [&](const BaselineMetric& m) { return !wanted(m); });
+  if (baseline.metrics.empty())
+    throw UserError(fmt::format("{}: no metric's key starts with {} (--only)",
+                                baseline.file.string(), fmt::join(prefixes, " or ")));
+  return baseline;
 }
 
 Baseline updated_baseline(const Baseline& baseline, const GateResult& result) {

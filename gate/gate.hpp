@@ -192,6 +192,11 @@ std::optional<double> metric_value(const nlohmann::json& doc, const std::string&
 GateResult check_baseline(const Baseline& baseline, const nlohmann::json& results,
                           const std::filesystem::path& results_file);
 
+/// The baseline with only the metrics whose key, as written in the file, starts with one of
+/// `prefixes` (`regress --only`: a gate of one VO's metrics, e.g. "algorithms.sparse."). Throws
+/// UserError naming the file and the prefixes when no metric is left.
+Baseline only_metrics(Baseline baseline, const std::vector<std::string>& prefixes);
+
 /// How `regress init` sets the tolerances.
 struct InitOptions {
   double rel_tol = 0.1;     ///< of each value

@@ -20,6 +20,8 @@
 #   GATE_SET  space-separated KEY.PATH=VALUE overrides for every job (`sweep plan --set`), to
 #             try a change without editing code, e.g.
 #             GATE_SET="pipeline.sparse.lk_refinement=false" examples/ci/run-gate.sh
+#   GATE_ONLY comma-separated key prefixes: compare only those metrics (`regress --only`), e.g.
+#             GATE_ONLY=algorithms.sparse. with GATE_SET="pipeline.vo=[sparse]" runs one VO
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 DRIFTLAB=${DRIFTLAB:-$here/../../build/bin/driftlab}
@@ -38,7 +40,7 @@ start=$(date +%s)
 "$DRIFTLAB" sweep merge "$OUT" --no-plots
 set +e
 "$DRIFTLAB" regress --baseline "$BASELINE" --results "$OUT" --junit "$OUT/regress-junit.xml" \
-  ${UPDATE:+--update}
+  ${UPDATE:+--update} ${GATE_ONLY:+--only "$GATE_ONLY"}
 status=$?
 set -e
 echo "run-gate: sweep, merge and gate in $(( $(date +%s) - start )) s; summary in $OUT/summary," \

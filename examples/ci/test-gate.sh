@@ -9,8 +9,11 @@
 # a 5x5 window is no longer harmless: sparse e'_p +62 %, p = 0.00076, and the gate says so.)
 # Output that is the same bytes passes: run-gate.sh itself shows that, against the baseline, on
 # every CI run (so the earlier `pipeline.threads=1` case, a gate run of its own, was dropped).
-# `scripts/test` runs it after run-gate.sh, so the frames come from the frame cache. The same
-# environment as run-gate.sh (DRIFTLAB, SWEEP, BASELINE, JOBS, DRIFTLAB_FRAME_CACHE).
+# `scripts/test` runs it after run-gate.sh, so the frames come from the frame cache. The cases
+# change the sparse VO only, so they run it alone (`pipeline.vo=[sparse]`) and the gate compares
+# its metrics and its smoothed stream's (GATE_ONLY); the sparse VO's output is the same bytes with
+# or without sparse_kf beside it (a warm gate with only that change: every metric +0.0 %).
+# The same environment as run-gate.sh (DRIFTLAB, SWEEP, BASELINE, JOBS, DRIFTLAB_FRAME_CACHE).
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d "${TMPDIR:-/tmp}/driftlab-gate-test.XXXXXX")
@@ -19,7 +22,8 @@ failures=0
 
 expect() {  # expect EXIT "KEY=VALUE"
   local want=$1 set=$2 log="$work/$(echo "$2" | tr -c 'a-z0-9\n' '_').log"
-  GATE_SET="$set" OUT="$work/sweep" "$here/run-gate.sh" >"$log" 2>&1
+  GATE_SET="pipeline.vo=[sparse] $set" GATE_ONLY=algorithms.sparse.,algorithms.sparse_ca. \
+    OUT="$work/sweep" "$here/run-gate.sh" >"$log" 2>&1
   local got=$?
   rm -rf "$work/sweep"
   local regressed

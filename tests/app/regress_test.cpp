@@ -136,6 +136,30 @@ TEST_F(Regress, MissingAndNullMetricsFail) {
       << r.out;
 }
 
+TEST_F(Regress, OnlyComparesTheMetricsUnderItsPrefixes) {
+  write_baseline(R"(,
+    {"key": "algorithms.pnp.ape.trans_m.rmse", "baseline": 0.01})");
+  write_results(0.0112, 0.50, 7.0);  // the APE +12 %: regressed; no pnp in the results
+  EXPECT_EQ(gate().exit_code, 5);
+  Result r = gate({"--only", "algorithms.sparse.regression"});
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("regress: 1 metrics: 1 pass"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("pnp"), std::string::npos) << r.out;
+  // A JSON-pointer key is matched as written, and the prefixes are comma-separated.
+  r = gate({"--only", "algorithms.sparse.ape,/algorithms/sparse/"});
+  EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
+  EXPECT_NE(r.out.find("regress: 2 metrics: 1 pass, 1 REGRESSED"), std::string::npos) << r.out;
+
+  r = gate({"--only", "algorithms.dense."});
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.err.find("baseline.json: no metric's key starts with algorithms.dense. (--only)"),
+            std::string::npos)
+      << r.err;
+  r = gate({"--only", "algorithms.sparse.", "--update"});  // would drop the others from the file
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.err.find("--update"), std::string::npos) << r.err;
+}
+
 TEST_F(Regress, UpdateWritesTheNewValuesAndKeepsTolerances) {
   write_baseline();
   write_results(0.02, 0.3, 9.0);
