@@ -406,10 +406,13 @@ Baseline only_metrics(Baseline baseline, const std::vector<std::string>& prefixe
     return std::any_of(prefixes.begin(), prefixes.end(),
                        [&](const std::string& p) { return m.key.rfind(p, 0) == 0; });
   };
+  const std::string first_key = baseline.metrics.empty() ? "" : baseline.metrics.front().key;
   std::erase_if(baseline.metrics, [&](const BaselineMetric& m) { return !wanted(m); });
   if (baseline.metrics.empty())
-    throw UserError(fmt::format("{}: no metric's key starts with {} (--only)",
-                                baseline.file.string(), fmt::join(prefixes, " or ")));
+    throw UserError(fmt::format(
+        "{}: no metric's key starts with {} (--only); expected the start of one of its keys, "
+        "such as {}",
+        baseline.file.string(), fmt::join(prefixes, " or "), first_key));
   return baseline;
 }
 

@@ -150,11 +150,14 @@ TEST_F(Regress, OnlyComparesTheMetricsUnderItsPrefixes) {
   EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
   EXPECT_NE(r.out.find("regress: 2 metrics: 1 pass, 1 REGRESSED"), std::string::npos) << r.out;
 
-  r = gate({"--only", "algorithms.dense."});
+  r = gate({"--only", "algorithms.dense.", "--junit", (dir_ / "junit.xml").string()});
   EXPECT_EQ(r.exit_code, 1) << r.out;
-  EXPECT_NE(r.err.find("baseline.json: no metric's key starts with algorithms.dense. (--only)"),
+  EXPECT_NE(r.err.find("baseline.json: no metric's key starts with algorithms.dense. (--only); "
+                       "expected the start of one of its keys, such as "
+                       "algorithms.sparse.ape.trans_m.rmse"),
             std::string::npos)
       << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "junit.xml"));            // nothing written
   r = gate({"--only", "algorithms.sparse.", "--update"});  // would drop the others from the file
   EXPECT_EQ(r.exit_code, 2) << r.out;
   EXPECT_NE(r.err.find("--update"), std::string::npos) << r.err;
