@@ -15,6 +15,7 @@
 #include <numbers>
 #include <string>
 #include <tuple>
+#include <utility>
 
 #include "core/error.hpp"
 #include "sim/render/alpha_mips.hpp"
@@ -152,6 +153,7 @@ struct StereoRenderer::Impl {
   int water_segments = 0;
   float water_radius_m = 0;
   float wave_amplitude_sum_m = 0;
+  float wave_slope_sum = 0;   // sum of amplitude x wavenumber: a bound on the waves' slope
   std::vector<float> wave_a;  // 4 per component
   std::vector<float> wave_phase;
   std::shared_ptr<RippleMaps> ripples;  // the wind ripples' slope maps (null: none)
@@ -197,14 +199,23 @@ struct StereoRenderer::Impl {
   // The ripples' slope maps at time t into ripple_tex (once per t).
   void upload_ripples(double t);
   bool reflects() const { return scene.water.enabled && options.reflections; }
-  // The scene mirrored in the water plane for one eye, into its reflection texture.
-  void draw_reflection(const SE3& T_W_C, int eye);
+  // The scene mirrored in the water plane for one eye, into its reflection texture: the rows
+  // of it that the eye's rows [row_begin, row_end) read (reflection_rows), or all of them.
+  void draw_reflection(const SE3& T_W_C, int eye, int row_begin = 0, int row_end = -1);
+  // The rows [first, last) of the reflection texture that the water shader samples for the
+  // eye's rows [row_begin, row_end).
+  std::pair<int, int> reflection_rows(int row_begin, int row_end) const;
+  // The most the waves' normal moves the water shader's reflection lookup [uv] (u_shift_max).
+  float reflection_shift_max() const {
+    return 0.15f * std::min(1.f, wave_slope_sum) * 1.001f + 1e-5f;
+  }
   // The eye's image: the water (with its reflection texture), the scene, the sky.
   void draw_eye(const SE3& T_W_C, double t, int eye);
   // draw_eye in steps: clear, draw rows [row_begin, row_end) (any number of times), resolve.
   void clear_eye(int eye);
   void draw_eye_rows(const SE3& T_W_C, double t, int eye, int row_begin, int row_end);
-  void resolve_eye(int eye);
+  // Resolves the multisampled rows [row_begin, row_end) (all rows by default) into resolve_tex.
+  void resolve_eye(int eye, int row_begin = 0, int row_end = -1);
   GrayImage read_eye(int eye);
   DepthImage render_depth(const SE3& T_W_C, double t);
 };
@@ -516,6 +527,7 @@ void StereoRenderer::set_waves(const std::vector<WaveComponent>& components) {
   impl_->wave_a.clear();
   impl_->wave_phase.clear();
   impl_->wave_amplitude_sum_m = 0;
+  impl_->wave_slope_sum = 0;
   for (const auto& w : c) {
     impl_->wave_a.insert(impl_->wave_a.end(),
                          {static_cast<float>(w.amplitude_m),
@@ -524,6 +536,7 @@ void StereoRenderer::set_waves(const std::vector<WaveComponent>& components) {
                           static_cast<float>(w.omega_rad_s)});
     impl_->wave_phase.push_back(static_cast<float>(w.phase_rad));
     impl_->wave_amplitude_sum_m += static_cast<float>(std::abs(w.amplitude_m));
+    impl_->wave_slope_sum += static_cast<float>(std::abs(w.amplitude_m * w.wavenumber_rad_m));
   }
 }
 
@@ -624,6 +637,7 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   glUniform1i(loc(water_prog, "u_has_reflection"), reflection != 0 ? 1 : 0);
   glUniform2f(loc(water_prog, "u_viewport"), static_cast<float>(rig.camera.width),
               static_cast<float>(rig.camera.height));
+  glUniform1f(loc(water_prog, "u_shift_max"), reflection_shift_max());
   glUniform1f(loc(water_prog, "u_body"), w.body_gray);
   glUniform1f(loc(water_prog, "u_turbidity"), w.turbidity);
   glUniform1f(loc(water_prog, "u_reflectivity"), w.reflectivity);
@@ -736,7 +750,25 @@ void StereoRenderer::Impl::draw_sky(const Eigen::Matrix4f& view, float mirror) {
   glDepthFunc(GL_LESS);
 }
 
-void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, int eye_index) {
+std::pair<int, int> StereoRenderer::Impl::reflection_rows(int row_begin, int row_end) const {
+  const int H = rig.camera.height, RH = refl_height;
+  // Under wind ripples the lookup moves with the ripples' slope and is blurred along it
+  // (kWaterFs): no simple bound, so the whole image.
+  if (ripples || (row_begin == 0 && row_end == H)) return {0, RH};
+  // Without them the water shader reads the texture bilinearly at uv = pixel centre /
+  // viewport + 0.15 n.xy, n the interpolated upward normal of the waves, clamped to
+  // reflection_shift_max: |n.xy| <= min(1, |grad eta|) <= min(1, sum of amplitude x
+  // wavenumber) wherever n is interpolated inside its triangle.
+  const double shift = reflection_shift_max();
+  const double v_lo = (row_begin + 0.5) / H - shift, v_hi = (row_end - 0.5) / H + shift;
+  // Texel rows: the bilinear pair about v RH - 0.5, and two more on each side for rounding.
+  const int first = static_cast<int>(std::floor(v_lo * RH - 0.5)) - 2;
+  const int last = static_cast<int>(std::floor(v_hi * RH - 0.5)) + 4;
+  return {std::clamp(first, 0, RH), std::clamp(last, 0, RH)};
+}
+
+void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, int eye_index, int row_begin,
+                                           int row_end) {
   const EyeTargets& e = eyes[static_cast<std::size_t>(eye_index)];
   const Eigen::Matrix4f view = to_view(T_W_C);
   const Eigen::Vector3f eye = T_W_C.translation().cast<float>();
@@ -747,6 +779,14 @@ void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, int eye_index) {
   const bool multisampled = options.reflection_msaa_samples > 1;
   glBindFramebuffer(GL_FRAMEBUFFER, multisampled ? e.refl_msaa_fbo : e.refl_fbo);
   glViewport(0, 0, RW, RH);
+  // A band of a rolling-shutter image draws only the mirror rows it reads (the rest of the
+  // texture keeps an earlier band's rows, which it never samples).
+  const auto [first, last] = reflection_rows(row_begin, row_end < 0 ? rig.camera.height : row_end);
+  const bool scissored = first > 0 || last < RH;
+  if (scissored) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(0, first, RW, last - first);
+  }
   glClearColor(scene.lighting.sky_brightness, 0, 0, 1);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_CLIP_DISTANCE0);
@@ -760,6 +800,7 @@ void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, int eye_index) {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.refl_fbo);
     glBlitFramebuffer(0, 0, RW, RH, 0, 0, RW, RH, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
+  if (scissored) glDisable(GL_SCISSOR_TEST);
   if (ripples) mip_chain->build(e.refl_tex, RW, RH, refl_levels);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
@@ -799,13 +840,15 @@ void StereoRenderer::Impl::draw_eye_rows(const SE3& T_W_C, double t, int eye_ind
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-void StereoRenderer::Impl::resolve_eye(int eye_index) {
+void StereoRenderer::Impl::resolve_eye(int eye_index, int row_begin, int row_end) {
   if (options.msaa_samples <= 1) return;
   const EyeTargets& e = eyes[static_cast<std::size_t>(eye_index)];
-  const int W = rig.camera.width, H = rig.camera.height;
+  const int W = rig.camera.width;
+  if (row_end < 0) row_end = rig.camera.height;
   glBindFramebuffer(GL_READ_FRAMEBUFFER, e.msaa_fbo);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, e.resolve_fbo);
-  glBlitFramebuffer(0, 0, W, H, 0, 0, W, H, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBlitFramebuffer(0, row_begin, W, row_end, 0, row_begin, W, row_end, GL_COLOR_BUFFER_BIT,
+                    GL_NEAREST);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
@@ -920,10 +963,12 @@ StereoImages StereoRenderer::render_bands(const std::vector<RowBand>& left,
     m.clear_eye(eye);
     for (const RowBand& b : *bands[static_cast<std::size_t>(eye)]) {
       const SE3 T_W_C = eye == 0 ? b.T_W_C : b.T_W_C * m.T_left_right;
-      if (m.reflects()) m.draw_reflection(T_W_C, eye);
+      if (m.reflects()) m.draw_reflection(T_W_C, eye, b.row_begin, b.row_end);
       m.draw_eye_rows(T_W_C, b.t_s, eye, b.row_begin, b.row_end);
+      // Resolved band by band: with multisampling llvmpipe's scissor box lets the next band's
+      // triangles into this band's last row (Render.BandsEqualWholeFramesAtEachBandsPose).
+      m.resolve_eye(eye, b.row_begin, b.row_end);
     }
-    m.resolve_eye(eye);
   }
   StereoImages out;
   out.left = m.read_eye(0);

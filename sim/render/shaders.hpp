@@ -295,6 +295,7 @@ uniform vec3 u_eye;
 uniform sampler2D u_reflection;
 uniform bool u_has_reflection;
 uniform vec2 u_viewport;
+uniform float u_shift_max;      // bound on the waves' tilt of the lookup [uv]
 uniform float u_body;
 uniform float u_turbidity;
 uniform float u_sky;
@@ -315,7 +316,11 @@ void main() {
 #else
   float refl = u_sky;
   if (u_has_reflection) {
-    vec2 uv = gl_FragCoord.xy / u_viewport + 0.15 * v_shade.xy * vec2(1.0, -1.0);
+    // The waves' normal tilts the lookup by at most u_shift_max (their slope bound), which
+    // only an attribute extrapolated outside its triangle under MSAA would pass: the band of
+    // the mirror image a rolling-shutter band draws holds every row it reads.
+    vec2 uv = gl_FragCoord.xy / u_viewport
+            + clamp(0.15 * v_shade.xy, -u_shift_max, u_shift_max) * vec2(1.0, -1.0);
 #if RIPPLES
     // Wind ripples: the mip-mapped moments averaged over this pixel's
     // footprint. Their mean slope tilts the reflected ray; their variance

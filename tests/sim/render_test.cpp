@@ -451,6 +451,53 @@ TEST(Render, MipLevelsOfTheMirrorImageAreTwoByTwoMeans) {
   }
 }
 
+// A rolling-shutter image, band by band, against its second method: each band's rows cut out of
+// a whole frame rendered at that band's pose and time. The bands draw only the rows of their
+// mirror images that their rows read (StereoRenderer::Impl::reflection_rows), so steep waves,
+// which move the reflection lookup by up to 0.15 x 0.6 of the image (about 43 rows), and a
+// camera that moves and turns from band to band would show any row read from an earlier band.
+TEST(Render, BandsEqualWholeFramesAtEachBandsPose) {
+  const SceneGeometry scene = checker_disc_over_water(Vec3(8, 0, -1.2), 1.0, 40, 220);
+  // Two trains of steep short waves: slope sum 2 x 0.02 x 2 pi / 0.4 = 0.63.
+  std::vector<WaveComponent> waves;
+  for (double dir : {0.3, 1.9}) {
+    const double k = 2 * std::numbers::pi / 0.4;
+    waves.push_back(WaveComponent{0.02, k, std::sqrt(9.81 * k), dir, 0.7 * dir});
+  }
+  RenderOptions msaa;
+  msaa.msaa_samples = 4;
+  msaa.reflection_msaa_samples = 4;
+  RenderOptions half;
+  half.reflection_resolution = ReflectionResolution::kHalf;
+  for (const RenderOptions& options : {RenderOptions{}, msaa, half}) {
+    StereoRenderer r(rig_640(), options);
+    r.upload(scene);
+    r.set_waves(waves);
+    std::vector<RowBand> bands;
+    const int kBands = 8, H = 480;
+    for (int i = 0; i < kBands; ++i) {
+      const SE3 turn(Eigen::AngleAxisd(0.02 * i, Vec3::UnitZ()).toRotationMatrix(), Vec3::Zero());
+      bands.push_back(RowBand{turn * camera_at(Vec3(0, 0.05 * i, -1.0 - 0.01 * i)), 0.03 * i,
+                              i * H / kBands, (i + 1) * H / kBands});
+    }
+    const StereoImages banded = r.render_bands(bands, bands);
+    StereoImages expected = banded;
+    for (const RowBand& b : bands) {
+      const StereoImages whole = r.render(b.T_W_C, b.t_s, false);
+      for (int y = b.row_begin; y < b.row_end; ++y)
+        for (int x = 0; x < 640; ++x) {
+          expected.left.pixels[static_cast<std::size_t>(y) * 640 + x] = whole.left.at(x, y);
+          expected.right.pixels[static_cast<std::size_t>(y) * 640 + x] = whole.right.at(x, y);
+        }
+    }
+    EXPECT_EQ(differing_pixels(banded.left, expected.left), 0)
+        << "msaa " << options.msaa_samples << ", reflection " << options.reflection_msaa_samples;
+    EXPECT_EQ(differing_pixels(banded.right, expected.right), 0);
+    // The test sees the reflection: the bands' images differ from a whole frame at one pose.
+    EXPECT_GT(differing_pixels(banded.left, r.render(bands[0].T_W_C, 0, false).left), 1000);
+  }
+}
+
 TEST(Render, BadRigIsAClearError) {
   StereoRig rig = rig_640();
   rig.camera.fx = -1;
