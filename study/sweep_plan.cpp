@@ -65,6 +65,17 @@ std::string problems_of(const UserError& e) {
   return out;
 }
 
+// Whether the scenario text with these overrides is a valid scenario.
+bool parses(const std::string& text, const std::string& label, const fs::path& dir,
+            const std::vector<std::string>& overrides) {
+  try {
+    parse_scenario(text, label, dir, overrides);
+    return true;
+  } catch (const UserError&) {
+    return false;
+  }
+}
+
 // Point values (YAML text per axis) of the design.
 std::vector<std::vector<std::string>> design_points(const Sweep& s, std::uint64_t seed) {
   std::vector<std::vector<std::string>> points;
@@ -156,8 +167,13 @@ SweepPlan plan_sweep(const Sweep& s) {
   for (std::size_t i = 0; i < s.set.size(); ++i) {
     const std::string o = s.set[i].first + "=" + s.set[i].second;
     set_overrides.push_back(o);
+  }
+  // Each fixed override alone, for an error at its line; one that only the others make valid
+  // (shutter: rolling with its line_delay_us) is not one.
+  const bool set_valid = parses(base_yaml, s.base.string(), base_dir, set_overrides);
+  for (std::size_t i = 0; i < s.set.size() && !set_valid; ++i) {
     try {
-      parse_scenario(base_yaml, s.base.string(), base_dir, {o});
+      parse_scenario(base_yaml, s.base.string(), base_dir, {set_overrides[i]});
     } catch (const UserError& e) {
       errors.add(fmt::format("{}: set.{}: got '{}', expected {} of the base scenario {}: {}",
                              s.set_where[i], s.set[i].first, s.set[i].second,
@@ -179,7 +195,20 @@ SweepPlan plan_sweep(const Sweep& s) {
   plan.seed = s.seed.value_or(resolved_base.seed);
   const std::string& R = plan.scenario_yaml;
 
-  // Every key path and every value of every axis, one at a time.
+  // Every key path and every value of every axis, one at a time. A value that the base rejects
+  // alone is an error unless a point of the design that holds it is valid (a zip of shutter:
+  // rolling with its line delays); the points themselves are checked below.
+  const auto points = design_points(s, plan.seed);
+  const auto valid_in_a_point = [&](std::size_t axis, const std::string& value) {
+    for (const auto& point : points) {
+      if (point[axis] != value) continue;
+      std::vector<std::string> overrides;
+      for (std::size_t i = 0; i < s.axes.size(); ++i)
+        overrides.push_back(s.axes[i].key + "=" + point[i]);
+      if (parses(R, s.base.string(), base_dir, overrides)) return true;
+    }
+    return false;
+  };
   for (std::size_t i = 0; i < s.axes.size(); ++i) {
     const SweepAxis& a = s.axes[i];
     std::vector<std::string> probe = a.levels;
@@ -188,6 +217,7 @@ SweepPlan plan_sweep(const Sweep& s) {
       try {
         parse_scenario(R, s.base.string(), base_dir, {a.key + "=" + probe[k]});
       } catch (const UserError& e) {
+        if (key_in_schema(a.key) && !a.continuous && valid_in_a_point(i, probe[k])) continue;
         if (!key_in_schema(a.key)) {
           errors.add(
               fmt::format("{}: axes[{}].key: got '{}', expected a key path of the base "
@@ -205,7 +235,6 @@ SweepPlan plan_sweep(const Sweep& s) {
   }
   errors.throw_if_any();
 
-  const auto points = design_points(s, plan.seed);
   plan.points = points.size();
   if (static_cast<double>(points.size()) * static_cast<double>(s.replicates) >
       static_cast<double>(kMaxJobs))

@@ -124,6 +124,53 @@ axes:
   EXPECT_EQ(sc.water.waves.water_depth_m, 0.6);
 }
 
+// A value that the base scenario rejects alone but a point of the design makes valid: a rolling
+// shutter needs a line delay, so a zip of shutter and line delay plans, and so do fixed
+// overrides that are valid together; a grid of the same axes holds the point (rolling, 0),
+// which is refused by name.
+TEST(SweepPlan, ValuesValidOnlyTogetherAreCheckedAsPoints) {
+  const SweepPlan zip = plan_sweep(sweep_from(R"(
+base: tiny_base.yaml
+design: zip
+axes:
+  - key: sensors.camera.shutter
+    values: [rolling, global]
+  - key: sensors.camera.line_delay_us
+    values: [50, 0]
+)"));
+  ASSERT_EQ(zip.jobs.size(), 2u);
+  EXPECT_EQ(param(zip.jobs[0], "sensors.camera.shutter"), "rolling");
+  const SweepPlan fixed = plan_sweep(sweep_from(R"(
+base: tiny_base.yaml
+set:
+  sensors.camera.shutter: rolling
+  sensors.camera.line_delay_us: 50
+axes:
+  - key: sensors.camera.right_offset_ms
+    values: [0, 5]
+)"));
+  EXPECT_EQ(fixed.jobs.size(), 2u);
+  try {
+    plan_sweep(sweep_from(R"(
+base: tiny_base.yaml
+design: grid
+axes:
+  - key: sensors.camera.shutter
+    values: [rolling, global]
+  - key: sensors.camera.line_delay_us
+    values: [50, 0]
+)"));
+    FAIL() << "the grid's point (rolling, 0) was accepted";
+  } catch (const UserError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("(sensors.camera.shutter=rolling, sensors.camera.line_delay_us=0): the "
+                        "combination is rejected"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("line_delay_us > 0 with shutter: rolling"), std::string::npos) << what;
+  }
+}
+
 // `sweep plan --set` (the gate's GATE_SET): the command line's value replaces the file's fixed
 // one or joins them, reaches every job's scenario, and may not fix a swept key or the seed.
 TEST(SweepPlan, CommandLineSetsReplaceOrJoinTheFixedOverrides) {
