@@ -129,15 +129,16 @@ axes:
 // overrides that are valid together; a grid of the same axes holds the point (rolling, 0),
 // which is refused by name.
 TEST(SweepPlan, ValuesValidOnlyTogetherAreCheckedAsPoints) {
-  const SweepPlan zip = plan_sweep(sweep_from(R"(
-base: tiny_base.yaml
-design: zip
+  const auto shutter_sweep = [](const std::string& design) {
+    return sweep_from("base: tiny_base.yaml\ndesign: " + design + R"(
 axes:
   - key: sensors.camera.shutter
     values: [rolling, global]
   - key: sensors.camera.line_delay_us
     values: [50, 0]
-)"));
+)");
+  };
+  const SweepPlan zip = plan_sweep(shutter_sweep("zip"));
   ASSERT_EQ(zip.jobs.size(), 2u);
   EXPECT_EQ(param(zip.jobs[0], "sensors.camera.shutter"), "rolling");
   const SweepPlan fixed = plan_sweep(sweep_from(R"(
@@ -151,15 +152,7 @@ axes:
 )"));
   EXPECT_EQ(fixed.jobs.size(), 2u);
   try {
-    plan_sweep(sweep_from(R"(
-base: tiny_base.yaml
-design: grid
-axes:
-  - key: sensors.camera.shutter
-    values: [rolling, global]
-  - key: sensors.camera.line_delay_us
-    values: [50, 0]
-)"));
+    plan_sweep(shutter_sweep("grid"));
     FAIL() << "the grid's point (rolling, 0) was accepted";
   } catch (const UserError& e) {
     const std::string what = e.what();
