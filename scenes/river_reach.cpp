@@ -835,6 +835,8 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
 
   sim::SceneGeometry g;
   g.lighting = outdoor_lighting(sky);
+  if (options.visibility_m)
+    g.lighting.fog_distance_m = static_cast<float>(*options.visibility_m / kKoschmiederContrast);
   if (!g.lighting.sun && options.cloud_contrast > 0) {
     g.lighting.cloud_contrast = static_cast<float>(options.cloud_contrast);
     g.sky_clouds = bake_cloud_layer(seed);

@@ -83,6 +83,10 @@ double river_terrain_z(const RiverReachOptions& options, std::uint64_t seed, dou
 /// Daylight of the river scene: overcast (diffuse sky, no sun) or sun.
 sim::Lighting outdoor_lighting(Sky sky);
 
+/// -ln(0.02): the visibility V at which a dark object's contrast has fallen to 2 %
+/// (Koschmieder's law), so the extinction length is V / 3.912.
+inline constexpr double kKoschmiederContrast = 3.912;
+
 /// Builds the tiles covering [north_min_m - view_margin_m, north_max_m +
 /// view_margin_m] (north_min_m <= north_max_m: the cameras' north range; at
 /// least one tile), closed at both ends by a wooded river bend across the

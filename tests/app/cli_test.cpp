@@ -72,7 +72,7 @@ TEST(Cli, EveryShippedScenarioIsValid) {
     const Result r = run_cli({"scenario", "check", "--quiet", e.path().string()});
     EXPECT_EQ(r.exit_code, 0) << e.path() << "\n" << r.output;
   }
-  EXPECT_GE(n, 9);  // river_crossing, river_survey, basin_exp1..7
+  EXPECT_GE(n, 10);  // river_crossing(_mist), river_survey, basin_exp1..7
 }
 
 TEST(Cli, CheckPrintsResolvedScenarioThatChecksAgain) {

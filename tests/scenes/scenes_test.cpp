@@ -640,6 +640,28 @@ TEST(RiverReach, SkyPicksTheLighting) {
   EXPECT_GT(cloud.lighting.ambient, sun.lighting.ambient);
 }
 
+// scene.river_reach.visibility_m: the haze's extinction length is the visibility over
+// -ln(0.02) = 3.912 (Koschmieder's law: at the visibility 2 % of a contrast is left, as the
+// renderer's exp(-d / fog_distance_m) gives); null keeps the sky's own haze.
+TEST(RiverReach, VisibilitySetsTheHazeByKoschmiedersLaw) {
+  RiverReachOptions o = river_defaults();
+  for (const Sky sky : {Sky::kOvercast, Sky::kSun})
+    EXPECT_EQ(build_river_reach(o, sky, kSeed, 0, 10).lighting.fog_distance_m,
+              outdoor_lighting(sky).fog_distance_m);
+  EXPECT_EQ(outdoor_lighting(Sky::kOvercast).fog_distance_m, 400.f);
+  o.visibility_m = 9000;  // the river paper's survey day
+  const float fog = build_river_reach(o, Sky::kOvercast, kSeed, 0, 10).lighting.fog_distance_m;
+  EXPECT_NEAR(fog, 9000 / 3.912, 0.01);
+  EXPECT_NEAR(std::exp(-9000 / fog), 0.02, 1e-4);
+  o.visibility_m = 5;
+  try {
+    build_river_reach(o, Sky::kOvercast, kSeed, 0, 10);
+    ADD_FAILURE() << "a visibility of 5 m was accepted";
+  } catch (const UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("visibility_m"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RiverReach, ExtremeOptionsStillGiveWellFormedScenes) {
   std::vector<RiverReachOptions> cases(6, river_defaults());
   cases[0].bank_slope_deg = 90;  // a vertical bank

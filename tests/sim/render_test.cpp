@@ -498,6 +498,49 @@ TEST(Render, BandsEqualWholeFramesAtEachBandsPose) {
   }
 }
 
+// Haze: a surface d metres away keeps exp(-d / fog_distance_m) of its contrast against the
+// sky's grey (the scene shader's transmittance; scene.river_reach.visibility_m sets the
+// distance by Koschmieder's law). A quad 0.1 d wide (50 px at any d), dark on its west half and
+// bright on its east half, its contrast in haze over its contrast in clear air, at 25-400 m.
+TEST(Render, HazeKeepsExpMinusDistanceOverItsLengthOfTheContrast) {
+  const auto contrast = [](double d, float fog_distance_m) {
+    SceneGeometry s = dark_scene();
+    s.lighting.ambient = 1.0f;  // no texel saturates: 240 x 0.675 / 255
+    s.lighting.sky_brightness = 0.5f;
+    s.lighting.fog_distance_m = fog_distance_m;
+    Texture t;
+    t.name = "halves";
+    t.width = t.height = 64;
+    for (int y = 0; y < 64; ++y)
+      for (int x = 0; x < 64; ++x) t.pixels.push_back(x < 32 ? 40 : 240);
+    s.textures.push_back(t);
+    const double w = 0.05 * d;
+    Mesh m = quad_mesh({Vec3(d, -w, -w), Vec3(d, w, -w), Vec3(d, w, w), Vec3(d, -w, w)},
+                       Vec3(-1, 0, 0), true);
+    m.material.texture = 0;
+    for (auto& v : m.vertices) {
+      v.u = static_cast<float>((v.y + w) / (2 * w));
+      v.v = static_cast<float>((v.z + w) / (2 * w));
+    }
+    s.meshes.push_back(m);
+    StereoRenderer r(rig_640(), RenderOptions{});
+    r.upload(s);
+    const GrayImage img = r.render(camera_at(Vec3::Zero()), 0, false).left;
+    double dark = 0, bright = 0;
+    for (int y = 225; y < 255; ++y)
+      for (int x = 0; x < 12; ++x) {
+        dark += img.at(300 + x, y);
+        bright += img.at(327 + x, y);
+      }
+    return (bright - dark) / (30 * 12);
+  };
+  for (double d : {25.0, 100.0, 400.0}) {
+    const double clear = contrast(d, 1e9f), hazy = contrast(d, 200.f);
+    ASSERT_GT(clear, 100.0) << d;
+    EXPECT_NEAR(hazy / clear, std::exp(-d / 200.0), 1.0 / clear) << "at " << d << " m";
+  }
+}
+
 TEST(Render, BadRigIsAClearError) {
   StereoRig rig = rig_640();
   rig.camera.fx = -1;
