@@ -133,7 +133,7 @@ struct RiverReachOptions {
       "3.13 km under sun (extinction lengths of 400 and 800 m); the river paper's survey day "
       "had 9 km. The cloud deck keeps its own fading. A misty morning: "
       "scenarios/river_crossing_mist.yaml",
-      yaml::at_least(10) & yaml::up_to(1e6, "clearer than the clearest air (about 300 km)"));
+      yaml::at_least(10) & yaml::up_to(3e5, "clearer than the clearest air (about 300 km)"));
     a("bridge", bridge, "Road bridge with piers across each reach tile");
     a("quay_wall", quay_wall,
       "Feature-poor sheet-piled quay wall (~30 m) on the east bank of each tile");
