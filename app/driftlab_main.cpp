@@ -242,6 +242,9 @@ struct RenderVerb : Pinned {
     cmd->add_option("--frames", frames, "Number of stereo frames (0 = all)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_flag("--depth", depth, "Also write ground-truth depth (depth/NNNNNN.pfm)");
+    cmd->add_flag("--masks", masks,
+                  "Also write the left image's mask of moving things (mask/NNNNNN.png: 255 "
+                  "where a moving vessel is seen, 0 elsewhere)");
     cmd->add_option("--set", sets, "Override a key: KEY.PATH=VALUE (repeatable)");
     cmd->add_flag("--force", force, "Replace an existing output folder");
   }
@@ -252,6 +255,7 @@ struct RenderVerb : Pinned {
     driftlab::pipeline::RenderSequenceOptions ro;
     ro.max_frames = frames;
     ro.depth = depth;
+    ro.masks = masks;
     ro.replace_existing = force;
     const auto summary = driftlab::pipeline::render_sequence(scenario, out, ro);
     std::cout << summary.brief() << "\n";
@@ -262,6 +266,7 @@ struct RenderVerb : Pinned {
   std::string file, out;
   int frames = 0;
   bool depth = false;
+  bool masks = false;
   std::vector<std::string> sets;
   bool force = false;
 };

@@ -4,8 +4,11 @@
 
 #include <cmath>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "core/atomic_file.hpp"
 #include "core/stopwatch.hpp"
+#include "core/yaml_io.hpp"
 #include "pipeline/frame_source.hpp"
 #include "pipeline/progress.hpp"
 #include "pipeline/render_stage.hpp"
@@ -16,7 +19,15 @@
 namespace driftlab::pipeline {
 namespace fs = std::filesystem;
 
-namespace {}  // namespace
+namespace {
+
+// The left image's mask of moving things, numbered as the export's frames (issue 46, item 5).
+void write_mask(const fs::path& path, const sim::GrayImage& mask) {
+  if (!cv::imwrite(path.string(), cv_view(mask)))
+    throw UserError(fmt::format("{}: cannot write the mask", path.string()));
+}
+
+}  // namespace
 
 std::string ExportSummary::brief() const {
   return fmt::format(
@@ -75,22 +86,35 @@ ExportSummary export_dataset(const Scenario& sc, const fs::path& out_dir,
   const RngStreams rng(sc.seed);
   const std::vector<sim::SampleTime> stamps =
       sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
+  // A scene with movers also gets their masks: mask_0/NNNNNN.png (the frames in order) and
+  // mask_0/moving_px.csv.
+  const bool masks = !scene.movers.empty();
+  const bool depth = writer->wants_depth();
   FrameSource source(sc, scene, mission.frames, stamps, run_threads(sc.pipeline.threads), 4,
-                     writer->wants_depth(), options.frame_cache);
+                     depth || masks, options.frame_cache);
+  std::string moving_csv = "frame,t_ns,moving_px\n";
+  if (masks) fs::create_directories(dir.path() / "mask_0");
   ExportSummary summary;
   double render_s = 0;
   Progress progress(options.progress, "export", mission.camera_gt.size(), options.progress_tty);
   while (std::optional<CapturedFrame> f = source.next()) {
     progress.update(f->k);
     render_s += f->render_ms / 1000;
-    writer->add_frame(stamps[f->k].t_stamp_ns, cv_view(f->images.left), cv_view(f->images.right),
-                      cv_view(f->images.depth_left));
+    const TimeNs t = stamps[f->k].t_stamp_ns;
+    writer->add_frame(t, cv_view(f->images.left), cv_view(f->images.right),
+                      depth ? cv_view(f->images.depth_left) : cv::Mat());
+    if (masks) {
+      write_mask(dir.path() / "mask_0" / fmt::format("{:06d}.png", summary.frames),
+                 f->images.moving_left);
+      moving_csv += fmt::format("{},{},{}\n", summary.frames, t, yaml::format_double(f->moving_px));
+    }
     truth.camera.push_back(mission.camera_gt[f->k]);
     ++summary.frames;
   }
   progress.update(mission.camera_gt.size());
   progress.finish();
   writer->finish(truth);
+  if (masks) write_file_atomic(dir.path() / "mask_0" / "moving_px.csv", moving_csv);
   fs::remove_all(staging);
   dir.commit();
   summary.imu_samples = sensor_data.imu.size();

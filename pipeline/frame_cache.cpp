@@ -31,7 +31,8 @@ using Row = FrameCacheReader::Row;
 namespace {
 
 constexpr const char* kIndexHeader =
-    "k,exposure_ms,blur_samples,width,height,left_bytes,left_fnv1a64,right_bytes,right_fnv1a64";
+    "k,exposure_ms,blur_samples,moving_px,width,height,left_bytes,left_fnv1a64,right_bytes,"
+    "right_fnv1a64";
 
 // The whole file as bytes; false when it cannot be read.
 bool read_bytes(const fs::path& path, std::string* out) {
@@ -92,18 +93,19 @@ bool parse_hash(const std::string& text, std::uint64_t* value) {
 // One index.csv row; false when it is not one.
 bool parse_row(const std::string& line, Row* r) {
   const std::vector<std::string> c = split_csv_line(line);
-  return c.size() == 9 && parse_number(c[0], &r->meta.k) &&
+  return c.size() == 10 && parse_number(c[0], &r->meta.k) &&
          parse_number(c[1], &r->meta.exposure_ms) && parse_number(c[2], &r->meta.blur_samples) &&
-         parse_number(c[3], &r->width) && parse_number(c[4], &r->height) &&
-         parse_number(c[5], &r->left_bytes) && parse_hash(c[6], &r->left_hash) &&
-         parse_number(c[7], &r->right_bytes) && parse_hash(c[8], &r->right_hash) && r->width > 0 &&
-         r->height > 0;
+         parse_number(c[3], &r->meta.moving_px) && parse_number(c[4], &r->width) &&
+         parse_number(c[5], &r->height) && parse_number(c[6], &r->left_bytes) &&
+         parse_hash(c[7], &r->left_hash) && parse_number(c[8], &r->right_bytes) &&
+         parse_hash(c[9], &r->right_hash) && r->width > 0 && r->height > 0 &&
+         r->meta.moving_px >= 0 && r->meta.moving_px <= 1;
 }
 
 std::string row_text(const Row& r) {
-  return fmt::format("{},{},{},{},{},{},{},{},{}\n", r.meta.k, r.meta.exposure_ms,
-                     r.meta.blur_samples, r.width, r.height, r.left_bytes, hex64(r.left_hash),
-                     r.right_bytes, hex64(r.right_hash));
+  return fmt::format("{},{},{},{},{},{},{},{},{},{}\n", r.meta.k, r.meta.exposure_ms,
+                     r.meta.blur_samples, r.meta.moving_px, r.width, r.height, r.left_bytes,
+                     hex64(r.left_hash), r.right_bytes, hex64(r.right_hash));
 }
 
 // The rows of an index.csv; "" or what is wrong with it.
@@ -225,6 +227,7 @@ void FrameCacheWriter::add(const CacheFrame& frame) {
   r.meta.k = frame.k;  // the metadata only: the images go to files
   r.meta.exposure_ms = frame.exposure_ms;
   r.meta.blur_samples = frame.blur_samples;
+  r.meta.moving_px = frame.moving_px;
   r.width = frame.left.width;
   r.height = frame.left.height;
   const std::size_t i = rows_.size();

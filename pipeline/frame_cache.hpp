@@ -4,7 +4,7 @@
 // (core/hash.hpp) holding:
 //   key.txt     the key text itself, compared whole on every lookup (so two keys never share
 //               an entry, whatever their hashes);
-//   index.csv   one row per frame: k, exposure, blur samples, size, and the length and
+//   index.csv   one row per frame: k, exposure, blur samples, moving share, size, the length and
 //               FNV-1a 64 of each image file; a last row `end,N` (a truncated index has none);
 //   NNNNNN_l.zst, NNNNNN_r.zst  the 8-bit rectified images, row by row, compressed by zstd
 //               (lossless).
@@ -44,6 +44,7 @@ struct CacheFrame {
   std::size_t k = 0;  ///< index into the run's frame times
   double exposure_ms = 0;
   int blur_samples = 1;
+  double moving_px = 0;  ///< CapturedFrame::moving_px
   sim::GrayImage left, right;
 };
 

@@ -72,6 +72,15 @@ std::string scene_fingerprint(const sim::SceneGeometry& scene) {
     f.add(m.material.albedo);
     f.add(m.material.specular);
     f.add(m.material.double_sided);
+    f.add(m.mover);
+  }
+  f.add(scene.movers.size());
+  for (const sim::MoverMotion& v : scene.movers) {
+    for (int i = 0; i < 3; ++i) f.add(v.p0_W[i]);
+    for (int i = 0; i < 3; ++i) f.add(v.v_W[i]);
+    f.add(v.heading_rad);
+    for (const sim::Oscillation* o : {&v.roll, &v.pitch, &v.heave})
+      for (const double x : {o->amplitude, o->period_s, o->phase_rad}) f.add(x);
   }
   const auto add_texture = [&f](const sim::Texture& t) {
     f.add(t.name);
@@ -120,7 +129,7 @@ std::string frame_cache_key(const std::string& identity, const Scenario& sc,
                             const sim::SceneGeometry& scene, const std::vector<FrameTruth>& truth,
                             const std::vector<sim::SampleTime>& stamps) {
   return fmt::format(
-      "driftlab frame cache key, version 1\n{}scene_fnv1a64 {}\ntruth_fnv1a64 {}\n"
+      "driftlab frame cache key, version 2\n{}scene_fnv1a64 {}\ntruth_fnv1a64 {}\n"
       "frames {}\n{}",
       identity, scene_fingerprint(scene), truth_fingerprint(truth, stamps), truth.size(),
       yaml::to_yaml(frame_deciding(sc), false));

@@ -29,6 +29,13 @@ cv::Mat cv_view(const sim::DepthImage& d) {
   return cv::Mat(d.height, d.width, CV_32FC1, const_cast<float*>(d.depth_m.data()));
 }
 
+double moving_share(const sim::GrayImage& mask) {
+  if (mask.pixels.empty()) return 0;
+  const auto n =
+      std::count_if(mask.pixels.begin(), mask.pixels.end(), [](std::uint8_t v) { return v != 0; });
+  return static_cast<double>(n) / static_cast<double>(mask.pixels.size());
+}
+
 int run_threads(int requested) {
   if (requested > 0) return requested;
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
@@ -54,8 +61,14 @@ struct Renderer {
     f.exposure_ms = camera->exposure_ms();  // this frame's (auto exposure)
     f.images = camera->capture(truth);
     f.blur_samples = camera->last_blur_samples();
-    if (depth)  // ground truth: the ideal pinhole depth at the centre of the exposure
-      f.images.depth_left = renderer.render(camera->T_W_C(truth), truth.t_s, true).depth_left;
+    if (depth || renderer.has_movers()) {  // ground truth at the centre of the exposure
+      sim::TruthImages t = renderer.render_truth(camera->T_W_C(truth), truth.t_s);
+      f.moving_px = moving_share(t.moving);
+      if (depth) {
+        f.images.depth_left = std::move(t.depth);
+        f.images.moving_left = std::move(t.moving);
+      }
+    }
     f.render_ms = watch.ms();
     return f;
   }
@@ -125,6 +138,7 @@ struct ReplayProducer : Producer {
     f.k = c.k;
     f.exposure_ms = c.exposure_ms;
     f.blur_samples = c.blur_samples;
+    f.moving_px = c.moving_px;
     f.images.left = std::move(c.left);
     f.images.right = std::move(c.right);
     f.render_ms = watch.ms();  // reading and decoding
@@ -145,7 +159,8 @@ struct FillProducer : Producer {
   std::optional<CapturedFrame> next() override {
     std::optional<CapturedFrame> f = render->next();
     if (f) {
-      writer->add({f->k, f->exposure_ms, f->blur_samples, f->images.left, f->images.right});
+      writer->add(
+          {f->k, f->exposure_ms, f->blur_samples, f->moving_px, f->images.left, f->images.right});
       return f;
     }
     if (writer) {
@@ -214,7 +229,7 @@ struct FrameSource::Impl {
   std::unique_ptr<Producer> open() {
     if (cache_options.dir.empty()) return render();
     if (depth) {
-      cache_status.note = "the frame cache keeps no ground-truth depth";
+      cache_status.note = "the frame cache keeps no ground-truth depth or masks";
       return render();
     }
     cache.emplace(cache_options.dir, cache_options.max_bytes);

@@ -28,6 +28,10 @@ struct CapturedFrame {
   double render_ms = 0;      ///< wall-clock time of rendering and camera effects
   double exposure_ms = 0;    ///< the exposure this frame was taken with
   int blur_samples = 1;      ///< renders averaged for its motion blur (CameraStage::blur_samples)
+  /// The share of the left image's pixels that show moving things (the scene's movers) at the
+  /// centre of the exposure, by sim::StereoRenderer::render_truth's mask; 0 in a scene without
+  /// movers (no pass drawn).
+  double moving_px = 0;
 };
 
 /// What the frame cache did for a source (metrics.json "frame_cache").
@@ -51,9 +55,9 @@ class FrameSource {
   /// Renders `scene` at the camera poses of `truth` (one per frame time), skipping the frames
   /// `stamps` marks dropped. threads >= 2: on a thread of its own, at most `queue_frames`
   /// ahead of the consumer; 1: inside next(). `scene` and `truth` must outlive the source.
-  /// depth: each frame also carries the true depth of the left image (images.depth_left; the
-  /// frame cache keeps no depth, so such a source renders). `cache`: where frames are kept
-  /// (an empty folder: nowhere).
+  /// depth: each frame also carries the true depth of the left image and its mask of moving
+  /// things (images.depth_left, images.moving_left; the frame cache keeps neither, so such a
+  /// source renders). `cache`: where frames are kept (an empty folder: nowhere).
   FrameSource(const Scenario& sc, const sim::SceneGeometry& scene,
               const std::vector<FrameTruth>& truth, const std::vector<sim::SampleTime>& stamps,
               int threads, std::size_t queue_frames = 4, bool depth = false,
@@ -78,6 +82,9 @@ class FrameSource {
 /// image gives an empty matrix.
 cv::Mat cv_view(const sim::GrayImage& image);
 cv::Mat cv_view(const sim::DepthImage& depth);
+
+/// The share of a mask's pixels that are set (non-zero); 0 for an empty mask.
+double moving_share(const sim::GrayImage& mask);
 
 /// The threads a run uses: `requested`, or every core when it is 0.
 int run_threads(int requested);

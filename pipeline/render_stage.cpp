@@ -11,7 +11,9 @@
 #include "core/rng.hpp"
 #include "core/stopwatch.hpp"
 #include "core/trajectory_io.hpp"
+#include "core/yaml_io.hpp"
 #include "pipeline/camera_stage.hpp"
+#include "pipeline/frame_source.hpp"
 #include "pipeline/run.hpp"
 #include "scenes/build_scene.hpp"
 #include "sim/render/renderer.hpp"
@@ -69,6 +71,7 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
   std::filesystem::create_directories(dir.path() / "left");
   std::filesystem::create_directories(dir.path() / "right");
   if (options.depth) std::filesystem::create_directories(dir.path() / "depth");
+  if (options.masks) std::filesystem::create_directories(dir.path() / "mask");
 
   // Ground-truth camera poses along the mission.
   const SE3 T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
@@ -98,7 +101,7 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
   summary.context = renderer.context_description();
 
   AtomicFile times(dir.path() / "times.csv");
-  times.write("frame,t_ns\n");
+  times.write("frame,t_ns,moving_px\n");
   const bool depth = options.depth || sc.render.ground_truth_depth;
   double render_s = 0;
   // The images as the camera delivers them (blur, rig error, lens, noise) at
@@ -112,17 +115,24 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
     if (k < stamps.size() && stamps[k].dropped) continue;
     const auto t0 = SteadyClock::now();
     sim::StereoImages img = camera.capture(truth[k]);
-    if (depth)  // ground truth: the ideal pinhole depth at the centre of the exposure
-      img.depth_left =
-          renderer.render(poses[k].T_W_C, ns_to_seconds(poses[k].t_ns), true).depth_left;
+    double moving_px = 0;
+    // Ground truth: the ideal pinhole camera at the centre of the exposure.
+    if (depth || options.masks || renderer.has_movers()) {
+      sim::TruthImages t = renderer.render_truth(poses[k].T_W_C, ns_to_seconds(poses[k].t_ns));
+      moving_px = moving_share(t.moving);
+      img.depth_left = std::move(t.depth);
+      img.moving_left = std::move(t.moving);
+    }
     render_s += seconds_since(t0);
     ++delivered;
     const std::string name = fmt::format("{:06d}", k);
     write_png(dir.path() / "left" / (name + ".png"), img.left);
     write_png(dir.path() / "right" / (name + ".png"), img.right);
     if (depth) write_pfm(dir.path() / "depth" / (name + ".pfm"), img.depth_left);
-    times.write(
-        fmt::format("{},{}\n", k, k < stamps.size() ? stamps[k].t_stamp_ns : poses[k].t_ns));
+    if (options.masks) write_png(dir.path() / "mask" / (name + ".png"), img.moving_left);
+    times.write(fmt::format("{},{},{}\n", k,
+                            k < stamps.size() ? stamps[k].t_stamp_ns : poses[k].t_ns,
+                            yaml::format_double(moving_px)));
   }
   times.commit();
   write_tum(dir.path() / "groundtruth.tum", poses);

@@ -17,6 +17,7 @@ namespace driftlab::pipeline {
 struct RenderSequenceOptions {
   int max_frames = 0;  // 0: every frame of the mission (or pipeline.max_frames)
   bool depth = false;  // also write depth/NNNNNN.pfm (metres, float)
+  bool masks = false;  // also write mask/NNNNNN.png (255: a moving thing; sim::TruthImages)
   bool replace_existing = false;
 };
 
@@ -38,8 +39,9 @@ StereoRig rig_of(const sim::CameraOptions& camera);
 void set_water_surface(sim::StereoRenderer* renderer, const Scenario& scenario);
 
 /// Simulates the motion, builds the scene around the track, renders every
-/// frame into out_dir/{left,right}/NNNNNN.png (+ depth/NNNNNN.pfm) and
-/// out_dir/times.csv (frame, t_ns); the folder appears only when complete.
+/// frame into out_dir/{left,right}/NNNNNN.png (+ depth/NNNNNN.pfm, mask/NNNNNN.png) and
+/// out_dir/times.csv (frame, t_ns, moving_px: the mask's share of the image, 0 in a scene
+/// without movers); the folder appears only when complete.
 RenderSequenceSummary render_sequence(const Scenario& scenario,
                                       const std::filesystem::path& out_dir,
                                       const RenderSequenceOptions& options);

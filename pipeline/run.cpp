@@ -375,7 +375,8 @@ double run_frame_loop(const FrameLoop& loop) {
   const Trajectory& camera_gt = loop.mission.camera_gt;
   const std::vector<EulerZYX>& platform = loop.mission.platform;
   AtomicFile frames_csv(dir / "frames.csv");
-  std::string header = "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms,exposure_ms,blur_samples";
+  std::string header =
+      "t_ns,yaw_deg,pitch_deg,roll_deg,render_ms,exposure_ms,blur_samples,moving_px";
   for (const Track& tr : tracks)
     if (tr.vo) header += vo_csv_header(tr.name);
   frames_csv.write(header + "\n");
@@ -396,10 +397,10 @@ double run_frame_loop(const FrameLoop& loop) {
     frame.t_ns = t;
     frame.left = cv_view(img.left);
     frame.right = cv_view(img.right);
-    std::string row =
-        fmt::format("{},{},{},{},{:.3f},{},{}", t, rad2deg(platform[k].yaw_rad),
-                    rad2deg(platform[k].pitch_rad), rad2deg(platform[k].roll_rad), render_ms,
-                    yaml::format_double(exposure_ms), captured->blur_samples);
+    std::string row = fmt::format("{},{},{},{},{:.3f},{},{},{}", t, rad2deg(platform[k].yaw_rad),
+                                  rad2deg(platform[k].pitch_rad), rad2deg(platform[k].roll_rad),
+                                  render_ms, yaml::format_double(exposure_ms),
+                                  captured->blur_samples, yaml::format_double(captured->moving_px));
     const std::vector<vo::VoResult> vo_results = process_vos(&tracks, frame, loop.threads);
     for (std::size_t i = 0; i < tracks.size(); ++i) {
       Track& tr = tracks[i];

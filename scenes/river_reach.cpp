@@ -20,6 +20,7 @@
 #include "scenes/sky_clouds.hpp"
 #include "scenes/textures.hpp"
 #include "scenes/trees.hpp"
+#include "scenes/vessels.hpp"
 
 namespace driftlab::scenes {
 
@@ -914,6 +915,7 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
   }
   add_river_bend(&g, static_cast<double>(k1 + 1) * len, -1, k, n, tex);
   add_river_bend(&g, static_cast<double>(k0) * len, 1, k, n, tex);
+  add_other_vessels(&g, options.vessels, seed, options.texture_contrast);
   return g;
 }
 

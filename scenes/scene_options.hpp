@@ -29,6 +29,46 @@ constexpr auto enum_table(Sky) {
   return std::array{std::pair{Sky::kOvercast, "overcast"}, std::pair{Sky::kSun, "sun"}};
 }
 
+/// Another vessel on the river (issue 46, item 4): a motor boat under way along the river at a
+/// steady speed, or moored (speed 0), rocking in roll, pitch and heave (sim::MoverMotion). Its
+/// pixels are the moving things of the masks (`driftlab render --masks`, frames.csv moving_px).
+struct OtherVesselOptions {
+  double north_m = 0;
+  double east_m = 7;
+  double speed_mps = 0;
+  double length_m = 7;
+  double beam_m = 2.4;
+  double freeboard_m = 0.7;
+  double roll_deg = 1.5;
+  double roll_period_s = 3.2;
+  double pitch_deg = 0.5;
+  double heave_m = 0.02;
+  double pitch_period_s = 2.1;
+
+  template <class A>
+  void visit(A& a) {
+    a("north_m", north_m, "Where its centre is at t = 0, along the river (NED north) [m]",
+      yaml::in_range(-1e5, 1e5));
+    a("east_m", east_m,
+      "Its centre line's distance from the river's centre line (east positive) [m]; the hull "
+      "must float between the banks: |east_m| + beam_m / 2 <= bank_distance_m",
+      yaml::in_range(-1000, 1000));
+    a("speed_mps", speed_mps,
+      "Speed along the river [m/s]: positive northwards, negative southwards, 0 moored "
+      "(heading north, alongside the bank)",
+      yaml::in_range(-15, 15));
+    a("length_m", length_m, "Hull length [m]", yaml::in_range(2, 60));
+    a("beam_m", beam_m, "Hull width [m]", yaml::in_range(0.8, 15));
+    a("freeboard_m", freeboard_m, "Deck height above the water [m]", yaml::in_range(0.2, 5));
+    a("roll_deg", roll_deg, "Amplitude of its roll [deg]", yaml::in_range(0, 20));
+    a("roll_period_s", roll_period_s, "Period of its roll [s]", yaml::in_range(0.5, 60));
+    a("pitch_deg", pitch_deg, "Amplitude of its pitch [deg]", yaml::in_range(0, 10));
+    a("heave_m", heave_m, "Amplitude of its heave [m]", yaml::in_range(0, 1));
+    a("pitch_period_s", pitch_period_s, "Period of its pitch and heave [s]",
+      yaml::in_range(0.5, 60));
+  }
+};
+
 struct RiverReachOptions {
   double river_width_m = 20.0;
   double reach_length_m = 120.0;
@@ -49,6 +89,7 @@ struct RiverReachOptions {
   bool quay_wall = true;
   int buildings = 4;
   double view_margin_m = 150.0;
+  std::vector<OtherVesselOptions> vessels;
 
   template <class A>
   void visit(A& a) {
@@ -143,6 +184,17 @@ struct RiverReachOptions {
       "Scenery built beyond both ends of the cameras' north range [m]; past it (rounded up to "
       "whole tiles) a wooded river bend closes the valley",
       yaml::in_range(0, 2000));
+    a("vessels", vessels,
+      "Other vessels on the river, each under way or moored (empty: none). "
+      "scenarios/river_crossing_traffic.yaml has one of each");
+    for (std::size_t i = 0; i < vessels.size(); ++i) {
+      const OtherVesselOptions& v = vessels[i];
+      const double edge = std::abs(v.east_m) + v.beam_m / 2;
+      a.require(edge <= bank_distance_m, "vessels",
+                "vessel " + std::to_string(i) +
+                    " on the water: |east_m| + beam_m / 2 = " + yaml::format_double(edge) +
+                    " m, at most bank_distance_m (" + yaml::format_double(bank_distance_m) + " m)");
+    }
   }
 };
 

@@ -16,6 +16,7 @@ MeshSkyObstruction::MeshSkyObstruction(const sim::SceneGeometry& scene, double c
   double e_min = n_min, e_max = -n_min;
   top_z_ = std::numeric_limits<double>::infinity();
   for (const sim::Mesh& m : scene.meshes) {
+    if (m.mover >= 0) continue;  // a vessel passing by: not a fixed obstruction of the sky
     auto at = [&m](std::uint32_t i) {
       const sim::Vertex& v = m.vertices[i];
       return Vec3(v.x, v.y, v.z);
@@ -135,7 +136,7 @@ std::vector<sim::MagneticAnomalyOptions> steel_anomalies(const sim::SceneGeometr
       return m.name.size() >= s.size() &&
              m.name.compare(m.name.size() - s.size(), s.size(), s) == 0;
     });
-    if (!steel || m.vertices.empty()) continue;
+    if (!steel || m.vertices.empty() || m.mover >= 0) continue;
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     for (const sim::Vertex& v : m.vertices) {
       const Vec3 p(v.x, v.y, v.z);

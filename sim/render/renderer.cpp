@@ -33,6 +33,7 @@ struct GpuMesh {
   GLsizei count = 0;
   Material material;
   bool on_body = false;  // Mesh::on_body
+  int mover = -1;        // Mesh::mover
   bool cutout = false;   // its texture has alpha: drawn alpha-tested, after the opaque meshes
   Eigen::Vector3f centre = Eigen::Vector3f::Zero();  // bounding sphere, mesh frame
   float radius = 0;
@@ -136,6 +137,8 @@ struct StereoRenderer::Impl {
   RenderOptions options;
   bool colour = false;                                  // ImageKind::kColour
   Eigen::Matrix4f T_W_B = Eigen::Matrix4f::Identity();  // where body meshes are drawn
+  std::vector<MoverMotion> movers;                      // SceneGeometry::movers
+  std::vector<Eigen::Matrix4f> T_W_M;                   // the movers' poses at the pass's time
   std::unique_ptr<GlContext> context;
   std::unique_ptr<MipChain> mip_chain;  // the mirror image's blur levels under wind ripples
   // Programs by variant: [mode][sun][cutout] with mode 0 gray, 1 linear depth.
@@ -188,7 +191,11 @@ struct StereoRenderer::Impl {
                            int W, int H);
   // The eyes' colour format: R8 gray, RGBA8 colour.
   unsigned eye_format() const { return colour ? GL_RGBA8 : GL_R8; }
-  void draw_scene(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, float mirror, int mode);
+  // The meshes at time t (the movers where they are then).
+  void draw_scene(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, float mirror, int mode,
+                  double t);
+  // Where mesh g is drawn: the identity, the body's pose or its mover's (T_W_M at the pass's t).
+  const Eigen::Matrix4f& model_of(const GpuMesh& g) const;
   void draw_mesh(GLuint prog, const GpuMesh& g);  // one mesh with the program in use
   void draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, double t, int mode,
                   GLuint reflection);  // 0: none
@@ -201,7 +208,7 @@ struct StereoRenderer::Impl {
   bool reflects() const { return scene.water.enabled && options.reflections; }
   // The scene mirrored in the water plane for one eye, into its reflection texture: the rows
   // of it that the eye's rows [row_begin, row_end) read (reflection_rows), or all of them.
-  void draw_reflection(const SE3& T_W_C, int eye, int row_begin = 0, int row_end = -1);
+  void draw_reflection(const SE3& T_W_C, double t, int eye, int row_begin = 0, int row_end = -1);
   // The rows [first, last) of the reflection texture that the water shader samples for the
   // eye's rows [row_begin, row_end).
   std::pair<int, int> reflection_rows(int row_begin, int row_end) const;
@@ -217,7 +224,7 @@ struct StereoRenderer::Impl {
   // Resolves the multisampled rows [row_begin, row_end) (all rows by default) into resolve_tex.
   void resolve_eye(int eye, int row_begin = 0, int row_end = -1);
   GrayImage read_eye(int eye);
-  DepthImage render_depth(const SE3& T_W_C, double t);
+  TruthImages render_truth(const SE3& T_W_C, double t);
 };
 
 StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& options, ImageKind kind)
@@ -342,7 +349,8 @@ void StereoRenderer::Impl::build_framebuffers() {
   refl_width = r == ReflectionResolution::kHalf ? (W + 1) / 2 : W;
   refl_height = r == ReflectionResolution::kFull ? H : (H + 1) / 2;
   for (EyeTargets& e : eyes) build_eye_targets(&e);
-  color_target_(&depth_fbo, &depth_tex, GL_R32F, &depth_rb, W, H);
+  // Red: the linear depth; green: 1 where the surface belongs to a mover (render_truth).
+  color_target_(&depth_fbo, &depth_tex, GL_RG32F, &depth_rb, W, H);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
@@ -385,6 +393,7 @@ void StereoRenderer::Impl::multisample_target_(GLuint* fbo, GLuint* color, GLuin
 
 void StereoRenderer::upload(const SceneGeometry& scene) {
   Impl& m = *impl_;
+  m.context->make_current();  // another renderer's context may be current on this thread
   for (auto& g : m.meshes) {
     glDeleteVertexArrays(1, &g.vao);
     glDeleteBuffers(1, &g.vbo);
@@ -404,10 +413,13 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
   // validation on this thread; the squares keep culling useful on long reaches.
   constexpr float kBatchCell_m = 50.f;
   std::vector<Mesh> merged;
-  std::map<std::tuple<int, float, float, bool, long, long, bool, std::array<float, 3>>, std::size_t>
+  std::map<std::tuple<int, float, float, bool, long, long, bool, int, std::array<float, 3>>,
+           std::size_t>
       batch_of;
   for (const Mesh& x : scene.meshes) {
     if (x.indices.empty()) continue;
+    if (x.mover >= static_cast<int>(scene.movers.size()))
+      throw InternalError(fmt::format("renderer: mesh '{}' names a missing mover", x.name));
     for (std::uint32_t i : x.indices)
       if (i >= x.vertices.size())
         throw InternalError(fmt::format("renderer: mesh '{}' has an index out of range", x.name));
@@ -420,7 +432,7 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     const auto key = std::make_tuple(
         x.material.texture, x.material.albedo, x.material.specular, x.material.double_sided,
         std::lround(std::floor(c.x() / kBatchCell_m)),
-        std::lround(std::floor(c.y() / kBatchCell_m)), x.on_body, x.material.colour);
+        std::lround(std::floor(c.y() / kBatchCell_m)), x.on_body, x.mover, x.material.colour);
     const auto [it, fresh] = batch_of.emplace(key, merged.size());
     if (fresh) {
       merged.push_back(x);
@@ -437,6 +449,7 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     GpuMesh g;
     g.material = mesh.material;
     g.on_body = mesh.on_body;
+    g.mover = mesh.mover;
     g.cutout = mesh.material.texture >= 0 &&
                !scene.textures[static_cast<std::size_t>(mesh.material.texture)].alpha.empty();
     g.count = static_cast<GLsizei>(mesh.indices.size());
@@ -471,6 +484,8 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
   }
   m.scene.lighting = scene.lighting;
   m.scene.water = scene.water;
+  m.movers = scene.movers;
+  m.T_W_M.assign(m.movers.size(), Eigen::Matrix4f::Identity());
 }
 
 void StereoRenderer::set_ripples(std::shared_ptr<RippleMaps> maps) {
@@ -540,8 +555,16 @@ void StereoRenderer::set_waves(const std::vector<WaveComponent>& components) {
   }
 }
 
+const Eigen::Matrix4f& StereoRenderer::Impl::model_of(const GpuMesh& g) const {
+  static const Eigen::Matrix4f identity = Eigen::Matrix4f::Identity();
+  if (g.on_body) return T_W_B;
+  return g.mover >= 0 ? T_W_M[static_cast<std::size_t>(g.mover)] : identity;
+}
+
 void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye,
-                                      float mirror, int mode) {
+                                      float mirror, int mode, double t) {
+  for (std::size_t i = 0; i < movers.size(); ++i)
+    T_W_M[i] = movers[i].T_W_M(t).matrix().cast<float>();
   const Lighting& L = scene.lighting;
   const int sun_variant = L.sun ? 1 : 0;
   const Eigen::Vector3f sun = L.sun_direction_W.normalized();
@@ -567,8 +590,7 @@ void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::
   draw_order.clear();
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     const GpuMesh& g = meshes[i];
-    const Eigen::Vector3f w =
-        g.on_body ? (T_W_B * g.centre.homogeneous()).head<3>().eval() : g.centre;
+    const Eigen::Vector3f w = (model_of(g) * g.centre.homogeneous()).head<3>();
     const Eigen::Vector3f c(w.x(), w.y(), w.z() * mirror);
     if (!sphere_visible(planes, c, g.radius)) continue;
     draw_order.emplace_back(std::max(0.f, (c - eye_m).norm() - g.radius), i);
@@ -610,7 +632,8 @@ void StereoRenderer::Impl::draw_mesh(GLuint prog, const GpuMesh& g) {
   glUniform1f(loc(prog, "u_albedo"), g.material.albedo);
   glUniform1f(loc(prog, "u_specular"), g.material.specular);
   glUniform3fv(loc(prog, "u_tint"), 1, g.material.colour.data());
-  set_mat4(prog, "u_model", g.on_body ? T_W_B : Eigen::Matrix4f::Identity().eval());
+  set_mat4(prog, "u_model", model_of(g));
+  glUniform1f(loc(prog, "u_moving"), g.mover >= 0 ? 1.f : 0.f);  // depth pass only
   glBindVertexArray(g.vao);
   glDrawElements(GL_TRIANGLES, g.count, GL_UNSIGNED_INT, nullptr);
 }
@@ -767,7 +790,7 @@ std::pair<int, int> StereoRenderer::Impl::reflection_rows(int row_begin, int row
   return {std::clamp(first, 0, RH), std::clamp(last, 0, RH)};
 }
 
-void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, int eye_index, int row_begin,
+void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, double t, int eye_index, int row_begin,
                                            int row_end) {
   const EyeTargets& e = eyes[static_cast<std::size_t>(eye_index)];
   const Eigen::Matrix4f view = to_view(T_W_C);
@@ -790,7 +813,7 @@ void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, int eye_index, int 
   glClearColor(scene.lighting.sky_brightness, 0, 0, 1);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_CLIP_DISTANCE0);
-  draw_scene(view, eye, -1.f, 0);
+  draw_scene(view, eye, -1.f, 0, t);
   // The mirrored sky where the ray looks down; where it looks up, the clear colour is the
   // sky at the horizon, so ripples that sample across the line see no step.
   if (!uniform_sky()) draw_sky(view, -1.f);
@@ -834,7 +857,7 @@ void StereoRenderer::Impl::draw_eye_rows(const SE3& T_W_C, double t, int eye_ind
   // then the scene nearest first, then the sky on the far plane where nothing
   // was drawn: every pixel is shaded about once.
   draw_water(view, eye, t, 0, reflects() ? e.refl_tex : 0);
-  draw_scene(view, eye, 1.f, 0);
+  draw_scene(view, eye, 1.f, 0, t);
   draw_sky(view, 1.f);
   if (band) glDisable(GL_SCISSOR_TEST);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -872,7 +895,7 @@ GrayImage StereoRenderer::Impl::read_eye(int eye_index) {
   return img;
 }
 
-DepthImage StereoRenderer::Impl::render_depth(const SE3& T_W_C, double t) {
+TruthImages StereoRenderer::Impl::render_truth(const SE3& T_W_C, double t) {
   const int W = rig.camera.width, H = rig.camera.height;
   const Eigen::Matrix4f view = to_view(T_W_C);
   const Eigen::Vector3f eye = T_W_C.translation().cast<float>();
@@ -881,17 +904,31 @@ DepthImage StereoRenderer::Impl::render_depth(const SE3& T_W_C, double t) {
   glClearColor(0, 0, 0, 0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
-  draw_scene(view, eye, 1.f, 1);
+  draw_scene(view, eye, 1.f, 1, t);
   draw_water(view, eye, t, 1, 0);
   glFinish();
-  DepthImage d;
-  d.width = W;
-  d.height = H;
-  d.depth_m.resize(static_cast<std::size_t>(W) * H);
-  glReadPixels(0, 0, W, H, GL_RED, GL_FLOAT, d.depth_m.data());
+  const std::size_t n = static_cast<std::size_t>(W) * H;
+  std::vector<float> rg(2 * n);
+  glReadPixels(0, 0, W, H, GL_RG, GL_FLOAT, rg.data());
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  return d;
+  TruthImages out;
+  out.depth.width = out.moving.width = W;
+  out.depth.height = out.moving.height = H;
+  out.depth.depth_m.resize(n);
+  out.moving.pixels.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    out.depth.depth_m[i] = rg[2 * i];
+    out.moving.pixels[i] = rg[2 * i + 1] > 0.5f ? 255 : 0;
+  }
+  return out;
 }
+
+TruthImages StereoRenderer::render_truth(const SE3& T_W_C, double t_s) {
+  impl_->context->make_current();
+  return impl_->render_truth(T_W_C, t_s);
+}
+
+bool StereoRenderer::has_movers() const { return !impl_->movers.empty(); }
 
 void StereoRenderer::set_body_pose(const SE3& T_W_B) {
   impl_->T_W_B = T_W_B.matrix().cast<float>();
@@ -901,7 +938,7 @@ ColourImage StereoRenderer::render_colour(const SE3& T_W_C, double t_s) {
   Impl& m = *impl_;
   DRIFTLAB_DEMAND_MSG(m.colour, "render_colour: the renderer draws gray images");
   m.context->make_current();
-  if (m.reflects()) m.draw_reflection(T_W_C, 0);
+  if (m.reflects()) m.draw_reflection(T_W_C, t_s, 0);
   m.draw_eye(T_W_C, t_s, 0);
   const Impl::EyeTargets& e = m.eyes[0];
   const int W = m.rig.camera.width, H = m.rig.camera.height;
@@ -930,12 +967,12 @@ StereoImages StereoRenderer::render(const SE3& T_W_C_left, double t_s, bool with
   // wait until a texture it samples is rasterised; so the right mirror image's vertices are
   // processed while the left one is rasterised, and so on (6 % faster than eye by eye).
   if (impl_->reflects()) {
-    impl_->draw_reflection(T_W_C_left, 0);
-    impl_->draw_reflection(T_W_C_right, 1);
+    impl_->draw_reflection(T_W_C_left, t_s, 0);
+    impl_->draw_reflection(T_W_C_right, t_s, 1);
   }
   impl_->draw_eye(T_W_C_left, t_s, 0);
   impl_->draw_eye(T_W_C_right, t_s, 1);
-  if (with_depth) out.depth_left = impl_->render_depth(T_W_C_left, t_s);
+  if (with_depth) out.depth_left = impl_->render_truth(T_W_C_left, t_s).depth;
   out.left = impl_->read_eye(0);
   out.right = impl_->read_eye(1);
   return out;
@@ -963,7 +1000,7 @@ StereoImages StereoRenderer::render_bands(const std::vector<RowBand>& left,
     m.clear_eye(eye);
     for (const RowBand& b : *bands[static_cast<std::size_t>(eye)]) {
       const SE3 T_W_C = eye == 0 ? b.T_W_C : b.T_W_C * m.T_left_right;
-      if (m.reflects()) m.draw_reflection(T_W_C, eye, b.row_begin, b.row_end);
+      if (m.reflects()) m.draw_reflection(T_W_C, b.t_s, eye, b.row_begin, b.row_end);
       m.draw_eye_rows(T_W_C, b.t_s, eye, b.row_begin, b.row_end);
       // Resolved band by band: with multisampling llvmpipe's scissor box lets the next band's
       // triangles into this band's last row (Render.BandsEqualWholeFramesAtEachBandsPose).

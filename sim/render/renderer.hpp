@@ -43,6 +43,16 @@ struct DepthImage {
 struct StereoImages {
   GrayImage left, right;
   DepthImage depth_left;  // empty unless ground-truth depth was requested
+  GrayImage moving_left;  // the moving things' mask (TruthImages::moving); empty unless asked for
+};
+
+/// The left camera's ground truth at one instant: the depth, and the mask of the moving things
+/// (255 where the surface seen belongs to a mover, Mesh::mover; 0 elsewhere: the static scene,
+/// the water, the sky). Single-sampled, one sample a pixel at its centre; a mover's mirror
+/// image in the water is not in the mask (the pixel shows the water).
+struct TruthImages {
+  DepthImage depth;
+  GrayImage moving;
 };
 
 /// Clip-space projection (column-vector convention, OpenGL NDC) of the
@@ -103,6 +113,12 @@ class StereoRenderer {
   /// each band's rows from its own pose and time; the right eye's bands give the left
   /// camera's pose at the right image's times. Without depth.
   StereoImages render_bands(const std::vector<RowBand>& left, const std::vector<RowBand>& right);
+
+  /// The left camera's depth and moving-things mask at pose T_W_C and time t_s, in one pass
+  /// (render(..., true)'s depth is this pass's).
+  TruthImages render_truth(const SE3& T_W_C, double t_s);
+  /// Whether the uploaded scene has movers (SceneGeometry::movers).
+  bool has_movers() const;
 
   /// Renders the left eye only, in colour, at pose T_W_C and time t_s (a renderer made with
   /// ImageKind::kColour; InternalError otherwise).

@@ -7,10 +7,14 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
+
+#include "core/rotation.hpp"
+#include "core/se3.hpp"
 
 namespace driftlab::sim {
 
@@ -55,12 +59,43 @@ struct Material {
   std::array<float, 3> colour{1.0f, 1.0f, 1.0f};
 };
 
+/// A sinusoid a sin(2 pi t / T + phase): one degree of freedom of a rocking object.
+struct Oscillation {
+  double amplitude = 0;  // [rad] or [m]
+  double period_s = 1;
+  double phase_rad = 0;
+  double at(double t_s) const {
+    return amplitude * std::sin(2 * std::numbers::pi * t_s / period_s + phase_rad);
+  }
+};
+
+/// How a moving object of the scene (a mover: another vessel) moves, in closed form so that
+/// every instant a renderer draws (a rolling shutter's band, a motion blur's sample, the
+/// reflection pass) has its exact pose: its origin runs at a constant velocity and heaves, and
+/// it rolls and pitches about its mean attitude, T_W_M(t) = (Rz(heading) Ry(pitch(t))
+/// Rx(roll(t)), p0 + v t + heave(t) e_down).
+struct MoverMotion {
+  Eigen::Vector3d p0_W = Eigen::Vector3d::Zero();  // origin at t = 0 (NED) [m]
+  Eigen::Vector3d v_W = Eigen::Vector3d::Zero();   // velocity (NED) [m/s]
+  double heading_rad = 0;
+  Oscillation roll, pitch;  // [rad]
+  Oscillation heave;        // [m], down positive
+  SE3 T_W_M(double t_s) const {
+    const Quat q = quat_from_euler_zyx({roll.at(t_s), pitch.at(t_s), heading_rad});
+    return SE3(q, p0_W + v_W * t_s + Eigen::Vector3d(0, 0, heave.at(t_s)));
+  }
+};
+
 struct Mesh {
   std::string name;
   // false: vertices in the world frame (NED), fixed. true: in the vessel's body frame (FRD),
   // drawn at the pose StereoRenderer::set_body_pose gives (the ship model seen from the
   // basin's overhead camera).
   bool on_body = false;
+  // -1: not moving. Otherwise an index into SceneGeometry::movers: the vertices are in that
+  // mover's frame, drawn at its pose at each instant, and its pixels are the moving things of
+  // StereoRenderer::render_truth's mask.
+  int mover = -1;
   std::vector<Vertex> vertices;
   std::vector<std::uint32_t> indices;  // triangles, 3 per face
   Material material;
@@ -115,6 +150,8 @@ struct SceneGeometry {
   WaterAppearance water;
   // The cloud deck's texture: unit-variance noise n stored as 128 + 32 n, tiling (empty: none).
   Texture sky_clouds;
+  // The moving objects (Mesh::mover indexes them).
+  std::vector<MoverMotion> movers;
 
   std::size_t triangle_count() const {
     std::size_t n = 0;

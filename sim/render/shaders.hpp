@@ -90,13 +90,14 @@ uniform vec3 u_tint;       // the material's colour (COLOUR images only)
 uniform vec3 u_sun_dir;
 uniform float u_sky;
 uniform vec3 u_eye;
+uniform float u_moving;    // DEPTH: 1 for a mover's mesh (the green channel: the moving mask)
 out vec4 frag;
 void main() {
 #if DEPTH
 #if CUTOUT
   if (texture(u_tex, v_uv).g < 0.5) discard;
 #endif
-  frag = vec4(v_view_z, 0.0, 0.0, 1.0);
+  frag = vec4(v_view_z, u_moving, 0.0, 1.0);
 #else
 #if CUTOUT
   vec2 ta = texture(u_tex, v_uv_light_fog.xy).rg;

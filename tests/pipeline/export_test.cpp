@@ -13,6 +13,9 @@
 #include <set>
 #include <sstream>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
 #include "core/csv.hpp"
 #include "core/trajectory_io.hpp"
 #include "eval/evaluate.hpp"
@@ -194,6 +197,43 @@ TEST_P(ExportRoundTrip, ExportIsTheSameBytesWhateverTheThreadCount) {
   // A bag keeps every stream in one file, beside its 6 calibration and info files.
   expect_same_bytes_whatever_the_thread_count(
       GetParam(), GetParam() == dataset::DatasetFormat::kRosbag ? 6u : 10u);
+}
+
+// A scene with movers (the crossing with its traffic) exports their masks beside the dataset:
+// mask_0/NNNNNN.png for each frame and mask_0/moving_px.csv, whose share is the PNG's (read
+// back by OpenCV), the same bytes with one or two threads.
+TEST(ExportMasks, ATrafficSceneGetsAMaskPerFrameAndItsShare) {
+  const fs::path root = test::unused_temp_path("export_masks");
+  Scenario sc = load_scenario(test::source_dir() / "scenarios/river_crossing_traffic.yaml");
+  sc.pipeline.max_frames = 5;
+  ExportOptions o;
+  o.format = dataset::DatasetFormat::kKitti;
+  for (int threads : {1, 2}) {
+    sc.pipeline.threads = threads;
+    export_dataset(sc, root / std::to_string(threads), o);
+  }
+  std::istringstream csv(slurp(root / "1" / "mask_0" / "moving_px.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "frame,t_ns,moving_px");
+  int frames = 0;
+  while (std::getline(csv, line)) {
+    const std::vector<std::string> cells = split_csv_line(line);
+    ASSERT_EQ(cells.size(), 3u) << line;
+    const fs::path png = root / "1" / "mask_0" / fmt::format("{:06d}.png", frames);
+    const cv::Mat mask = cv::imread(png.string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(mask.empty()) << png;
+    const double share = cv::countNonZero(mask) / static_cast<double>(mask.total());
+    EXPECT_EQ(std::stod(cells[2]), share) << line;
+    EXPECT_GT(share, 0.001) << line;  // the moored boat is in view
+    const fs::path rel = fs::relative(png, root / "1");
+    EXPECT_TRUE(slurp(png) == slurp(root / "2" / rel)) << rel;
+    ++frames;
+  }
+  EXPECT_EQ(frames, 5);
+  EXPECT_EQ(slurp(root / "1" / "mask_0" / "moving_px.csv"),
+            slurp(root / "2" / "mask_0" / "moving_px.csv"));
+  fs::remove_all(root);
 }
 
 // A ROS 2 bag (written only: its round trip is the decoder test's, tests/dataset/rosbag_test):

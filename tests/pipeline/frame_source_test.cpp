@@ -24,10 +24,10 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kFrameSourceDir = DRIFTLAB_SOURCE_DIR;
 
-// A short, noisy, auto-exposed look across the river: every camera effect that keeps state
-// from frame to frame (noise streams, exposure) is on.
+// A short, noisy, auto-exposed look across the river, with its traffic (a moored boat in view):
+// every camera effect that keeps state from frame to frame (noise streams, exposure) is on.
 struct RiverLook {
-  RiverLook() : sc(load_scenario(kFrameSourceDir / "scenarios/river_crossing.yaml")) {
+  RiverLook() : sc(load_scenario(kFrameSourceDir / "scenarios/river_crossing_traffic.yaml")) {
     sc.sensors.camera.auto_exposure.enabled = true;
     scene = scenes::build_scene(sc.scene, sc.seed, -10, 30);
     for (int k = 0; k < 8; ++k) {
@@ -68,6 +68,8 @@ TEST(FrameSource, RenderThreadDeliversTheSerialFramesInOrderSkippingDropped) {
     EXPECT_EQ(a[i].exposure_ms, b[i].exposure_ms) << i;
     EXPECT_TRUE(a[i].images.left.pixels == b[i].images.left.pixels) << i;
     EXPECT_TRUE(a[i].images.right.pixels == b[i].images.right.pixels) << i;
+    EXPECT_EQ(a[i].moving_px, b[i].moving_px) << i;
+    EXPECT_GT(a[i].moving_px, 0.001) << i;  // the moored boat is in view
   }
   EXPECT_FALSE(a[0].images.left.pixels == a[1].images.left.pixels);  // the frames do move
   EXPECT_EQ(serial.info().triangles, threaded.info().triangles);
@@ -124,6 +126,7 @@ void expect_same_frames(const std::vector<CapturedFrame>& a, const std::vector<C
     EXPECT_EQ(a[i].k, b[i].k) << what << " " << i;
     EXPECT_EQ(a[i].exposure_ms, b[i].exposure_ms) << what << " " << i;
     EXPECT_EQ(a[i].blur_samples, b[i].blur_samples) << what << " " << i;
+    EXPECT_EQ(a[i].moving_px, b[i].moving_px) << what << " " << i;
     EXPECT_TRUE(a[i].images.left.pixels == b[i].images.left.pixels) << what << " " << i;
     EXPECT_TRUE(a[i].images.right.pixels == b[i].images.right.pixels) << what << " " << i;
   }
@@ -205,8 +208,11 @@ TEST(FrameSourceCache, FramesWithDepthAreRenderedNotCached) {
   const auto frames = all_frames(source);
   ASSERT_FALSE(frames.empty());
   EXPECT_FALSE(frames[0].images.depth_left.depth_m.empty());
+  for (const CapturedFrame& f : frames)  // the mask whose share frames.csv's moving_px gives
+    EXPECT_EQ(moving_share(f.images.moving_left), f.moving_px);
+  EXPECT_GT(frames[0].moving_px, 0.0);
   EXPECT_EQ(source.cache_status().state, "off");
-  EXPECT_NE(source.cache_status().note.find("no ground-truth depth"), std::string::npos);
+  EXPECT_NE(source.cache_status().note.find("no ground-truth depth or masks"), std::string::npos);
   fs::remove_all(cache.dir);
 }
 

@@ -25,6 +25,7 @@
 #include "scenes/river_reach.hpp"
 #include "scenes/scene_options.hpp"
 #include "scenes/textures.hpp"
+#include "scenes/vessels.hpp"
 #include "scenes/wave_basin.hpp"
 
 namespace driftlab::scenes {
@@ -659,6 +660,93 @@ TEST(RiverReach, VisibilitySetsTheHazeByKoschmiedersLaw) {
     ADD_FAILURE() << "a visibility of 5 m was accepted";
   } catch (const UserError& e) {
     EXPECT_NE(std::string(e.what()).find("visibility_m"), std::string::npos) << e.what();
+  }
+}
+
+// Other vessels (scene.river_reach.vessels, issue 46 item 4): each is a mover whose pose is its
+// closed-form motion, whose hull stays within its length, beam and draft, and whose options are
+// checked against the river; a reach without vessels is the scene it was.
+TEST(OtherVessels, MoveAsTheirOptionsSay) {
+  OtherVesselOptions launch;
+  launch.north_m = 70;
+  launch.east_m = 4;
+  launch.speed_mps = -1.5;
+  const sim::MoverMotion m = vessel_motion(launch, kSeed, 0);
+  EXPECT_NEAR(m.heading_rad, std::numbers::pi, 1e-12);  // heading south, down the river
+  for (double t : {0.0, 10.0, 47.3}) {
+    const SE3 T = m.T_W_M(t);
+    EXPECT_NEAR(T.translation().x(), 70 - 1.5 * t, 1e-9);
+    EXPECT_NEAR(T.translation().y(), 4, 1e-9);
+    EXPECT_LE(std::abs(T.translation().z()), launch.heave_m + 1e-12);
+  }
+  // Its roll reaches the amplitude asked for over a period, and no more.
+  double most = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const double t = launch.roll_period_s * i / 1000;
+    most = std::max(most, std::abs(m.roll.at(t)));
+  }
+  EXPECT_NEAR(most, launch.roll_deg * std::numbers::pi / 180, 1e-4);
+  OtherVesselOptions moored;
+  moored.speed_mps = 0;
+  const sim::MoverMotion still = vessel_motion(moored, kSeed, 1);
+  EXPECT_EQ(still.heading_rad, 0.0);
+  EXPECT_NEAR((still.T_W_M(100).translation() - still.T_W_M(0).translation()).head<2>().norm(), 0.0,
+              1e-12);
+  // The phases are the seed's: the same again, another for another vessel or seed.
+  EXPECT_EQ(vessel_motion(launch, kSeed, 0).roll.phase_rad, m.roll.phase_rad);
+  EXPECT_NE(vessel_motion(launch, kSeed, 1).roll.phase_rad, m.roll.phase_rad);
+  EXPECT_NE(vessel_motion(launch, kSeed + 1, 0).roll.phase_rad, m.roll.phase_rad);
+}
+
+TEST(OtherVessels, HullsStayInTheirDimensionsAndTheRestOfTheSceneIsUnchanged) {
+  RiverReachOptions o = river_defaults();
+  OtherVesselOptions a, b;
+  a.east_m = -5;
+  b.east_m = 8.6;
+  b.length_m = 6;
+  b.beam_m = 2.2;
+  o.vessels = {a, b};
+  const sim::SceneGeometry with = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
+  const sim::SceneGeometry& without = default_reach();
+  expect_well_formed(with);
+  ASSERT_EQ(with.movers.size(), 2u);
+  EXPECT_TRUE(without.movers.empty());
+  ASSERT_GT(with.meshes.size(), without.meshes.size());
+  for (std::size_t i = 0; i < without.meshes.size(); ++i) {
+    EXPECT_EQ(with.meshes[i].name, without.meshes[i].name);
+    EXPECT_EQ(with.meshes[i].mover, -1);
+    EXPECT_EQ(with.meshes[i].vertices.size(), without.meshes[i].vertices.size());
+  }
+  for (std::size_t i = 0; i < without.textures.size(); ++i)
+    EXPECT_TRUE(with.textures[i].pixels == without.textures[i].pixels) << i;
+  for (std::size_t i = without.meshes.size(); i < with.meshes.size(); ++i) {
+    const sim::Mesh& m = with.meshes[i];
+    ASSERT_GE(m.mover, 0) << m.name;
+    const OtherVesselOptions& v = m.mover == 0 ? a : b;
+    for (const sim::Vertex& p : m.vertices) {
+      EXPECT_LE(std::abs(p.x), v.length_m / 2 + 1e-4) << m.name;
+      EXPECT_LE(std::abs(p.y), vessel_half_beam(v, p.x) + 0.02) << m.name;
+      EXPECT_LE(p.z, 0.6 + 1e-4) << m.name;                     // the draft
+      EXPECT_GE(p.z, -(v.freeboard_m * 1.35 + 2.0)) << m.name;  // the wheelhouse's roof
+    }
+  }
+  EXPECT_EQ(vessel_half_beam(a, 0), a.beam_m / 2);
+  EXPECT_NEAR(vessel_half_beam(a, a.length_m / 2), 0.1 * a.beam_m / 2, 1e-12);
+}
+
+TEST(OtherVessels, AVesselOffTheWaterIsRefusedNamingIt) {
+  RiverReachOptions o = river_defaults();
+  OtherVesselOptions v;
+  v.east_m = 9.5;  // 9.5 + 1.2 > the bank at 10 m
+  o.vessels = {OtherVesselOptions{}, v};
+  try {
+    build_river_reach(o, Sky::kOvercast, kSeed, 0, 10);
+    ADD_FAILURE() << "a vessel on the bank was accepted";
+  } catch (const UserError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("vessels"), std::string::npos) << what;
+    EXPECT_NE(what.find("vessel 1"), std::string::npos) << what;
+    EXPECT_NE(what.find("10.7"), std::string::npos) << what;
   }
 }
 

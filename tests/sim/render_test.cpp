@@ -457,7 +457,15 @@ TEST(Render, MipLevelsOfTheMirrorImageAreTwoByTwoMeans) {
 // which move the reflection lookup by up to 0.15 x 0.6 of the image (about 43 rows), and a
 // camera that moves and turns from band to band would show any row read from an earlier band.
 TEST(Render, BandsEqualWholeFramesAtEachBandsPose) {
-  const SceneGeometry scene = checker_disc_over_water(Vec3(8, 0, -1.2), 1.0, 40, 220);
+  SceneGeometry scene = checker_disc_over_water(Vec3(8, 0, -1.2), 1.0, 40, 220);
+  // And a copy of the disc moving east behind it at 3 m/s (4 px from band to band), so that
+  // each band draws the movers, and their mirror images, at its own time.
+  scene.meshes.push_back(scene.meshes[0]);
+  scene.meshes.back().mover = 0;
+  MoverMotion east;
+  east.p0_W = Vec3(4, -1.5, 0);
+  east.v_W = Vec3(0, 3, 0);
+  scene.movers.push_back(east);
   // Two trains of steep short waves: slope sum 2 x 0.02 x 2 pi / 0.4 = 0.63.
   std::vector<WaveComponent> waves;
   for (double dir : {0.3, 1.9}) {
@@ -539,6 +547,79 @@ TEST(Render, HazeKeepsExpMinusDistanceOverItsLengthOfTheContrast) {
     ASSERT_GT(clear, 100.0) << d;
     EXPECT_NEAR(hazy / clear, std::exp(-d / 200.0), 1.0 / clear) << "at " << d << " m";
   }
+}
+
+// The moving things' mask (issue 46, item 5): a mover's mask is exactly the pixels whose depth
+// differs from a render of the scene without it (a second method), over water (its part under
+// the waterline is hidden) and behind a static wall that hides a part of it; and the mover is
+// where its closed-form motion puts it: a square facing the camera, moving east, has its mask's
+// centroid on the projection of its centre at each instant (a fronto-parallel square projects
+// affinely, so its area's centroid is its centre's image).
+TEST(Render, MoversMaskIsWhereTheirDepthDiffersFromTheSceneWithoutThem) {
+  SceneGeometry with = dark_scene();
+  with.water.enabled = true;
+  with.meshes = box_meshes(Vec3(7, 0.4, -2.5), Vec3(7.5, 1.5, -0.6), false);  // a static wall
+  const std::size_t statics = with.meshes.size();
+  for (Mesh m : box_meshes(Vec3(-0.3, -0.8, -0.9), Vec3(0.3, 0.8, 0.3), false)) {
+    m.mover = 0;  // a hull in its own frame, 0.3 m of it under the water
+    with.meshes.push_back(m);
+  }
+  Mesh square =
+      quad_mesh({Vec3(0, -0.5, -1.5), Vec3(0, 0.5, -1.5), Vec3(0, 0.5, -0.5), Vec3(0, -0.5, -0.5)},
+                -Vec3::UnitX(), false);
+  square.mover = 1;
+  with.meshes.push_back(square);
+  MoverMotion hull;
+  hull.p0_W = Vec3(10, -2.0, 0);
+  hull.v_W = Vec3(0, 1.5, 0);
+  hull.roll = {0.1, 2.0, 0.3};
+  hull.heave = {0.05, 1.5, 0.0};
+  MoverMotion sliding;
+  sliding.p0_W = Vec3(20, -3.0, -0.5);
+  sliding.v_W = Vec3(0, 1.37, 0);
+  with.movers = {hull, sliding};
+  SceneGeometry without = with;
+  without.meshes.resize(statics);
+  without.movers.clear();
+  StereoRenderer a(rig_640(), RenderOptions{}), b(rig_640(), RenderOptions{});
+  a.upload(with);
+  b.upload(without);
+  EXPECT_TRUE(a.has_movers());
+  EXPECT_FALSE(b.has_movers());
+  const SE3 T_W_C = camera_at(Vec3(0, 0, -1.0));
+  for (double t : {0.1, 0.8, 1.9}) {
+    const TruthImages moving = a.render_truth(T_W_C, t), still = b.render_truth(T_W_C, t);
+    int set = 0, wrong = 0, square_px = 0;
+    double square_u = 0;
+    const double z_square = 20 - T_W_C.translation().x();
+    for (std::size_t i = 0; i < moving.moving.pixels.size(); ++i) {
+      const bool differs = moving.depth.depth_m[i] != still.depth.depth_m[i];
+      const bool masked = moving.moving.pixels[i] == 255;
+      set += masked;
+      wrong += masked != differs || (moving.moving.pixels[i] != 0 && !masked);
+      if (masked && std::abs(moving.depth.depth_m[i] - z_square) < 1e-3) {
+        ++square_px;
+        square_u += static_cast<double>(i % 640);
+      }
+    }
+    EXPECT_EQ(wrong, 0) << "t " << t;
+    EXPECT_GT(set, 3000) << "t " << t;
+    EXPECT_GT(square_px, 500) << "t " << t;
+    // The pixel centres whose columns the square's edges enclose (half-open, as rasterised).
+    const double east = sliding.T_W_M(t).translation().y() - T_W_C.translation().y();
+    const double first = std::ceil(319.5 + 500 * (east - 0.5) / z_square);
+    const double last = std::ceil(319.5 + 500 * (east + 0.5) / z_square) - 1;
+    EXPECT_NEAR(square_u / square_px, (first + last) / 2, 0.01) << "t " << t;
+  }
+  // The wall hides a part of the hull at t = 1.9 (east of 0.4 m, behind x = 7): the mask there
+  // shows the wall, not the hull.
+  const TruthImages late = a.render_truth(T_W_C, 1.9);
+  const int u_wall = static_cast<int>(319.5 + 500 * 1.0 / 7.0);
+  const int v_wall = static_cast<int>(239.5 + 500 * (-1.0 - -1.0) / 7.0) + 20;
+  EXPECT_EQ(late.moving.at(u_wall, v_wall), 0);
+  EXPECT_NEAR(late.depth.at(u_wall, v_wall), 7.0, 0.01);
+  EXPECT_EQ(late.moving.at(u_wall, v_wall + 16), 255);  // below the wall: the hull
+  EXPECT_GT(late.depth.at(u_wall, v_wall + 16), 9.6);
 }
 
 TEST(Render, BadRigIsAClearError) {
