@@ -88,7 +88,7 @@ ExportSummary export_dataset(const Scenario& sc, const fs::path& out_dir,
       sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
   // A scene with movers also gets their masks: mask_0/NNNNNN.png (the frames in order) and
   // mask_0/moving_px.csv.
-  const bool masks = !scene.movers.empty();
+  const bool masks = scene_moves(sc, scene);
   const bool depth = writer->wants_depth();
   FrameSource source(sc, scene, mission.frames, stamps, run_threads(sc.pipeline.threads), 4,
                      depth || masks, options.frame_cache);

@@ -73,6 +73,7 @@ std::string scene_fingerprint(const sim::SceneGeometry& scene) {
     f.add(m.material.specular);
     f.add(m.material.double_sided);
     f.add(m.mover);
+    f.add_all(m.sway);  // std::array<float, 2>: no padding
   }
   f.add(scene.movers.size());
   for (const sim::MoverMotion& v : scene.movers) {

@@ -61,7 +61,7 @@ struct Renderer {
     f.exposure_ms = camera->exposure_ms();  // this frame's (auto exposure)
     f.images = camera->capture(truth);
     f.blur_samples = camera->last_blur_samples();
-    if (depth || renderer.has_movers()) {  // ground truth at the centre of the exposure
+    if (depth || renderer.has_moving_things()) {  // ground truth at the centre of the exposure
       sim::TruthImages t = renderer.render_truth(camera->T_W_C(truth), truth.t_s);
       f.moving_px = moving_share(t.moving);
       if (depth) {

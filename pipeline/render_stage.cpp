@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -48,6 +49,14 @@ void set_water_surface(sim::StereoRenderer* renderer, const Scenario& sc) {
   renderer->set_waves(sim::wave_components(sc.water.waves, rng.stream("waves.phases")));
   renderer->set_ripples(std::make_shared<sim::RippleMaps>(sc.water.wind, sc.water.current,
                                                           rng.stream("water.ripples")));
+  renderer->set_sway(sim::vegetation_sway(sc.water.wind, rng.stream("wind.gusts")));
+}
+
+bool scene_moves(const Scenario& sc, const sim::SceneGeometry& scene) {
+  if (!scene.movers.empty()) return true;
+  if (sim::vegetation_sway(sc.water.wind, Rng(0)).empty()) return false;
+  return std::any_of(scene.meshes.begin(), scene.meshes.end(),
+                     [](const sim::Mesh& m) { return !m.sway.empty(); });
 }
 
 StereoRig rig_of(const sim::CameraOptions& c) {
@@ -117,7 +126,7 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
     sim::StereoImages img = camera.capture(truth[k]);
     double moving_px = 0;
     // Ground truth: the ideal pinhole camera at the centre of the exposure.
-    if (depth || options.masks || renderer.has_movers()) {
+    if (depth || options.masks || renderer.has_moving_things()) {
       sim::TruthImages t = renderer.render_truth(poses[k].T_W_C, ns_to_seconds(poses[k].t_ns));
       moving_px = moving_share(t.moving);
       img.depth_left = std::move(t.depth);

@@ -7,6 +7,7 @@
 
 #include "core/camera.hpp"
 #include "pipeline/scenario.hpp"
+#include "sim/render/scene_geometry.hpp"
 
 namespace driftlab::sim {
 class StereoRenderer;
@@ -34,9 +35,13 @@ struct RenderSequenceSummary {
 /// The stereo rig of the scenario's camera options.
 StereoRig rig_of(const sim::CameraOptions& camera);
 
-/// Shows the scenario's water on `renderer`: the wave field (with the phases
-/// the vessel physics uses) and the wind ripples.
+/// Shows the scenario's water and wind on `renderer`: the wave field (with the phases
+/// the vessel physics uses), the wind ripples and the vegetation's sway.
 void set_water_surface(sim::StereoRenderer* renderer, const Scenario& scenario);
+
+/// Whether anything in the scene moves as `sc` renders it: its movers, or its vegetation in
+/// water.wind's gusts (StereoRenderer::has_moving_things before the upload).
+bool scene_moves(const Scenario& sc, const sim::SceneGeometry& scene);
 
 /// Simulates the motion, builds the scene around the track, renders every
 /// frame into out_dir/{left,right}/NNNNNN.png (+ depth/NNNNNN.pfm, mask/NNNNNN.png) and

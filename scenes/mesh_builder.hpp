@@ -85,7 +85,8 @@ class MeshBuilder {
   sim::Mesh mesh_;
 };
 
-/// Appends `src` to `dst` (vertices, triangles), translated by `offset`.
+/// Appends `src` to `dst` (vertices, triangles, sway weights: a mesh without them is rigid),
+/// translated by `offset`.
 void append_mesh(sim::Mesh* dst, const sim::Mesh& src, const Vec3& offset);
 
 /// Adds a mesh to the scene unless it is empty.

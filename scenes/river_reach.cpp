@@ -760,7 +760,9 @@ void add_skeleton_trees(sim::SceneGeometry* g, const RiverTileLayout& L, const B
     return it->second;
   };
   const auto add = [&](const TreeSpec& t, int cards, int first_part) {
-    const auto [wood, leaves] = grow_and_dress(t, k, tex, cards);
+    auto [wood, leaves] = grow_and_dress(t, k, tex, cards);
+    set_plant_sway(&wood, t.base_W, t.height_m, 0.f);
+    set_plant_sway(&leaves, t.base_W, t.height_m, 1.f);
     append_mesh(&chunk(t, first_part, wood), wood, Vec3::Zero());
     const int part = first_part + (leaf_shape_of(t.species) == LeafShape::kBroad ? 1 : 2);
     append_mesh(&chunk(t, part, leaves), leaves, Vec3::Zero());
@@ -900,7 +902,14 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
           }
         }
       }
-    add_mesh(&g, reeds.take());
+    sim::Mesh reed_mesh = reeds.take();
+    // A blade bends from its foot (texture v = 1) to its tip (v = 0): psi = (1 - v)^2, a reed's
+    // tip as compliant as a tall tree's top, and fluttering at half a leaf's.
+    for (const sim::Vertex& v : reed_mesh.vertices) {
+      const float h = 1.f - v.v;
+      reed_mesh.sway.push_back({h * h, 0.5f * h});
+    }
+    add_mesh(&g, std::move(reed_mesh));
 
     if (L.bridge) add_bridge(&g, L, k, n, tex);
     if (L.quay) add_quay(&g, L, k, tex);

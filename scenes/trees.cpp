@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "core/error.hpp"
+#include "sim/wind/gusts.hpp"
 
 namespace driftlab::scenes {
 
@@ -393,6 +394,15 @@ void dress_tree(const TreeForm& f, const TreeSkeleton& s, int cards, Rng* rng, M
   std::stable_sort(out.begin(), out.end(),
                    [](const Card& a, const Card& b) { return a.out_m > b.out_m; });
   for (const Card& c : out) leaves->card(c.centre, c.axis_u, c.axis_v, c.normal);
+}
+
+void set_plant_sway(sim::Mesh* mesh, const Vec3& base_W, double height_m, float flutter) {
+  mesh->sway.resize(mesh->vertices.size());
+  const double scale = height_m / sim::kReferenceTreeHeight_m;
+  for (std::size_t i = 0; i < mesh->vertices.size(); ++i) {
+    const double h = std::clamp((base_W.z() - mesh->vertices[i].z) / height_m, 0.0, 1.0);
+    mesh->sway[i] = {static_cast<float>(scale * h * h), flutter};
+  }
 }
 
 }  // namespace driftlab::scenes

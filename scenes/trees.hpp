@@ -109,4 +109,10 @@ int tree_triangle_count(const TreeSkeleton& s, int lod, int cards);
 void dress_tree(const TreeForm& f, const TreeSkeleton& s, int cards, Rng* rng, MeshBuilder* wood,
                 MeshBuilder* leaves);
 
+/// The sway weights of a plant's mesh (sim::Mesh::sway): the first bending mode of a cantilever,
+/// psi(h) = h^2 with h the vertex's height over the plant's (0 at the foot, 1 at the top), scaled
+/// by height_m / sim::kReferenceTreeHeight_m (a taller tree's top moves further); `flutter` for
+/// each vertex (1: leaf cards).
+void set_plant_sway(sim::Mesh* mesh, const Vec3& base_W, double height_m, float flutter);
+
 }  // namespace driftlab::scenes

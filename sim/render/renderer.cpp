@@ -34,6 +34,8 @@ struct GpuMesh {
   Material material;
   bool on_body = false;  // Mesh::on_body
   int mover = -1;        // Mesh::mover
+  GLuint sway_vbo = 0;   // Mesh::sway (0: rigid)
+  float sway_most = 0;   // its largest sway or flutter weight
   bool cutout = false;   // its texture has alpha: drawn alpha-tested, after the opaque meshes
   Eigen::Vector3f centre = Eigen::Vector3f::Zero();  // bounding sphere, mesh frame
   float radius = 0;
@@ -139,6 +141,10 @@ struct StereoRenderer::Impl {
   Eigen::Matrix4f T_W_B = Eigen::Matrix4f::Identity();  // where body meshes are drawn
   std::vector<MoverMotion> movers;                      // SceneGeometry::movers
   std::vector<Eigen::Matrix4f> T_W_M;                   // the movers' poses at the pass's time
+  VegetationSway sway;                                  // set_sway (empty: still)
+  float sway_reach_m = 0;  // the most a unit-weight vertex moves (sway and flutter)
+  // The sway's uniforms at time t (phases reduced modulo 2 pi in double precision).
+  void set_sway_uniforms(GLuint prog, double t) const;
   std::unique_ptr<GlContext> context;
   std::unique_ptr<MipChain> mip_chain;  // the mirror image's blur levels under wind ripples
   // Programs by variant: [mode][sun][cutout] with mode 0 gray, 1 linear depth.
@@ -398,6 +404,7 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     glDeleteVertexArrays(1, &g.vao);
     glDeleteBuffers(1, &g.vbo);
     glDeleteBuffers(1, &g.ebo);
+    if (g.sway_vbo != 0) glDeleteBuffers(1, &g.sway_vbo);
   }
   m.meshes.clear();
   if (!m.textures.empty())
@@ -442,6 +449,13 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     const auto base = static_cast<std::uint32_t>(d.vertices.size());
     d.vertices.insert(d.vertices.end(), x.vertices.begin(), x.vertices.end());
     for (std::uint32_t i : x.indices) d.indices.push_back(base + i);
+    if (!x.sway.empty() || !d.sway.empty()) {  // a rigid mesh's vertices weigh 0
+      d.sway.resize(base, {0.f, 0.f});
+      if (x.sway.empty())
+        d.sway.resize(d.vertices.size(), {0.f, 0.f});
+      else
+        d.sway.insert(d.sway.end(), x.sway.begin(), x.sway.end());
+    }
   }
   for (const Mesh& mesh : merged) {
     if (mesh.material.texture >= static_cast<int>(scene.textures.size()))
@@ -474,6 +488,18 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     glEnableVertexAttribArray(2);
     glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex),
                           reinterpret_cast<void*>(offsetof(Vertex, u)));
+    if (!mesh.sway.empty()) {
+      if (mesh.sway.size() != mesh.vertices.size())
+        throw InternalError(
+            fmt::format("renderer: mesh '{}' has a sway weight per vertex short", mesh.name));
+      for (const auto& w : mesh.sway) g.sway_most = std::max({g.sway_most, w[0], w[1]});
+      glGenBuffers(1, &g.sway_vbo);
+      glBindBuffer(GL_ARRAY_BUFFER, g.sway_vbo);
+      glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.sway.size() * 2 * sizeof(float)),
+                   mesh.sway.data(), GL_STATIC_DRAW);
+      glEnableVertexAttribArray(3);
+      glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
+    }  // else attribute 3 keeps its current value, (0, 0): rigid
     glGenBuffers(1, &g.ebo);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ebo);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.indices.size() * 4),
@@ -555,6 +581,33 @@ void StereoRenderer::set_waves(const std::vector<WaveComponent>& components) {
   }
 }
 
+void StereoRenderer::Impl::set_sway_uniforms(GLuint prog, double t) const {
+  constexpr int kMax = 8;  // u_sway's size
+  const int n = sway.empty() ? 0 : std::min<int>(kMax, static_cast<int>(sway.components.size()));
+  glUniform1i(loc(prog, "u_sway_n"), n);
+  if (n == 0) return;
+  const double two_pi = 2 * std::numbers::pi;
+  std::array<float, 4 * kMax> c{};
+  for (int k = 0; k < n; ++k) {
+    const SwayComponent& s = sway.components[static_cast<std::size_t>(k)];
+    c[4 * k] = static_cast<float>(s.amplitude_m);
+    c[4 * k + 1] = static_cast<float>(s.wavenumber_rad_m);
+    c[4 * k + 2] = static_cast<float>(std::fmod(s.omega_rad_s * t + s.phase_rad, two_pi));
+  }
+  glUniform4fv(loc(prog, "u_sway"), kMax, c.data());
+  glUniform2f(loc(prog, "u_wind_dir"), static_cast<float>(sway.direction_W.x()),
+              static_cast<float>(sway.direction_W.y()));
+  glUniform2f(loc(prog, "u_flutter"), static_cast<float>(sway.flutter_amplitude_m),
+              static_cast<float>(std::fmod(sway.flutter_omega_rad_s * t, two_pi)));
+  glUniform2f(loc(prog, "u_sway_reach"), static_cast<float>(sway.sway_bound_m()),
+              static_cast<float>(sway.flutter_amplitude_m));
+}
+
+void StereoRenderer::set_sway(const VegetationSway& sway) {
+  impl_->sway = sway;
+  impl_->sway_reach_m = static_cast<float>(sway.sway_bound_m() + 1.5 * sway.flutter_amplitude_m);
+}
+
 const Eigen::Matrix4f& StereoRenderer::Impl::model_of(const GpuMesh& g) const {
   static const Eigen::Matrix4f identity = Eigen::Matrix4f::Identity();
   if (g.on_body) return T_W_B;
@@ -580,6 +633,7 @@ void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::
     glUniform1f(loc(prog, "u_fog"), L.fog_distance_m);
     glUniform3f(loc(prog, "u_eye"), eye.x(), eye.y(), eye.z() * mirror);
     glUniform1i(loc(prog, "u_tex"), 0);
+    set_sway_uniforms(prog, t);
   };
   glActiveTexture(GL_TEXTURE0);
   // Meshes outside the view are skipped: a CPU rasteriser is bound by vertex work.
@@ -592,7 +646,7 @@ void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::
     const GpuMesh& g = meshes[i];
     const Eigen::Vector3f w = (model_of(g) * g.centre.homogeneous()).head<3>();
     const Eigen::Vector3f c(w.x(), w.y(), w.z() * mirror);
-    if (!sphere_visible(planes, c, g.radius)) continue;
+    if (!sphere_visible(planes, c, g.radius + g.sway_most * sway_reach_m)) continue;
     draw_order.emplace_back(std::max(0.f, (c - eye_m).norm() - g.radius), i);
   }
   std::sort(draw_order.begin(), draw_order.end());
@@ -928,7 +982,12 @@ TruthImages StereoRenderer::render_truth(const SE3& T_W_C, double t_s) {
   return impl_->render_truth(T_W_C, t_s);
 }
 
-bool StereoRenderer::has_movers() const { return !impl_->movers.empty(); }
+bool StereoRenderer::has_moving_things() const {
+  const Impl& m = *impl_;
+  return !m.movers.empty() ||
+         (!m.sway.empty() && std::any_of(m.meshes.begin(), m.meshes.end(),
+                                         [](const GpuMesh& g) { return g.sway_vbo != 0; }));
+}
 
 void StereoRenderer::set_body_pose(const SE3& T_W_B) {
   impl_->T_W_B = T_W_B.matrix().cast<float>();

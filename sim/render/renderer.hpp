@@ -23,6 +23,7 @@
 #include "sim/render/scene_geometry.hpp"
 #include "sim/waves/ripple_spectrum.hpp"
 #include "sim/waves/wave_field.hpp"
+#include "sim/wind/gusts.hpp"
 
 namespace driftlab::sim {
 
@@ -101,6 +102,9 @@ class StereoRenderer {
   /// at each frame's time and shared by both eyes): drawn in the shading only,
   /// not in the geometry or the depth (none when null or empty, the default).
   void set_ripples(std::shared_ptr<RippleMaps> maps);
+  /// How the wind moves the meshes with sway weights (Mesh::sway): drawn in every pass at
+  /// its instant, and in render_truth's mask (still when empty, the default).
+  void set_sway(const VegetationSway& sway);
   /// Where the body meshes (Mesh::on_body) are drawn: the body (FRD) frame's pose in the
   /// world (NED). The identity until set.
   void set_body_pose(const SE3& T_W_B);
@@ -117,8 +121,9 @@ class StereoRenderer {
   /// The left camera's depth and moving-things mask at pose T_W_C and time t_s, in one pass
   /// (render(..., true)'s depth is this pass's).
   TruthImages render_truth(const SE3& T_W_C, double t_s);
-  /// Whether the uploaded scene has movers (SceneGeometry::movers).
-  bool has_movers() const;
+  /// Whether anything of the uploaded scene moves: movers (SceneGeometry::movers), or meshes
+  /// with sway weights while set_sway's wind blows.
+  bool has_moving_things() const;
 
   /// Renders the left eye only, in colour, at pose T_W_C and time t_s (a renderer made with
   /// ImageKind::kColour; InternalError otherwise).

@@ -99,6 +99,10 @@ struct Mesh {
   std::vector<Vertex> vertices;
   std::vector<std::uint32_t> indices;  // triangles, 3 per face
   Material material;
+  // Empty: rigid. Otherwise one per vertex: how far it sways in the wind's gusts, as a share of
+  // the top of a sim::kReferenceTreeHeight_m tree (sim::VegetationSway::sway_m), and how far it
+  // flutters (1 for a leaf card). StereoRenderer::set_sway says how the wind moves them.
+  std::vector<std::array<float, 2>> sway;
 };
 
 /// Light and sky.

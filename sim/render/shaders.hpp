@@ -18,6 +18,7 @@ inline constexpr const char* kSceneVs = R"(
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
+layout(location = 3) in vec2 a_sway;  // Mesh::sway: sway and flutter weights ((0, 0): rigid)
 uniform mat4 u_view;       // world -> camera (optical)
 uniform mat4 u_proj;
 uniform mat4 u_model;      // mesh -> world: the identity, or the body's pose for a body mesh
@@ -27,8 +28,18 @@ uniform float u_ambient;
 uniform float u_diffuse;
 uniform float u_fog;
 uniform vec3 u_eye;
+// The wind in the vegetation (sim::VegetationSway at this pass's instant): a unit-weight vertex
+// at distance s downwind moves by sum_k a_k sin(p_k - kappa_k s) along u_wind_dir, a leaf also
+// by its flutter, downwind and half of it up or down.
+uniform int u_sway_n;      // 0: nothing sways
+uniform vec4 u_sway[8];    // a_k [m], kappa_k [rad/m], p_k [rad]
+uniform vec2 u_wind_dir;
+uniform vec2 u_flutter;    // amplitude [m], phase at this instant [rad]
+uniform vec2 u_sway_reach; // the most a unit weight sways and flutters [m]
+uniform float u_moving;    // 1 for a mover's mesh
 #if DEPTH
 out float v_view_z;
+out float v_moving;        // 1: a moving thing (the green channel: the moving mask)
 #if CUTOUT
 out vec2 v_uv;
 #endif
@@ -41,10 +52,19 @@ out vec3 v_normal;
 #endif
 void main() {
   vec3 w = (u_model * vec4(a_pos, 1.0)).xyz;
+  float moving = u_moving;
+  if (u_sway_n > 0 && a_sway != vec2(0.0)) {
+    float s = dot(u_wind_dir, w.xy), g = 0.0;
+    for (int k = 0; k < u_sway_n; ++k) g += u_sway[k].x * sin(u_sway[k].z - u_sway[k].y * s);
+    float f = u_flutter.x * sin(u_flutter.y + 37.0 * w.x + 91.0 * w.y + 53.0 * w.z);
+    w += vec3(u_wind_dir * (a_sway.x * g + a_sway.y * f), 0.5 * a_sway.y * f);
+    if (dot(a_sway, u_sway_reach) > 0.001) moving = 1.0;  // it moves by a millimetre or more
+  }
   vec3 p = vec3(w.xy, w.z * u_mirror);
   vec4 c = u_view * vec4(p, 1.0);
 #if DEPTH
   v_view_z = c.z;
+  v_moving = moving;
 #if CUTOUT
   v_uv = a_uv;
 #endif
@@ -90,14 +110,16 @@ uniform vec3 u_tint;       // the material's colour (COLOUR images only)
 uniform vec3 u_sun_dir;
 uniform float u_sky;
 uniform vec3 u_eye;
-uniform float u_moving;    // DEPTH: 1 for a mover's mesh (the green channel: the moving mask)
+#if DEPTH
+in float v_moving;
+#endif
 out vec4 frag;
 void main() {
 #if DEPTH
 #if CUTOUT
   if (texture(u_tex, v_uv).g < 0.5) discard;
 #endif
-  frag = vec4(v_view_z, u_moving, 0.0, 1.0);
+  frag = vec4(v_view_z, v_moving > 0.5 ? 1.0 : 0.0, 0.0, 1.0);
 #else
 #if CUTOUT
   vec2 ta = texture(u_tex, v_uv_light_fog.xy).rg;

@@ -126,6 +126,7 @@ struct WindOptions {
   double shelter = 1.0;
   double fetch_m = 100.0;
   RippleLevel ripple_level = RippleLevel::kSlick;
+  bool sway = true;
 
   template <class A>
   void visit(A& a) {
@@ -148,6 +149,11 @@ struct WindOptions {
       "term 1.56e-3 U at the wind reaching the water (it falls to glassy water in light air); "
       "'spectrum', the integral of Elfouhaily et al.'s spectrum (fitted for U of 3 m/s and "
       "more; about 0.01 even in light air at a short fetch)");
+    a("sway", sway,
+      "The river bank's trees, bushes and reeds sway in this wind's gusts (a damped oscillator "
+      "per plant driven by a Kaimal gust spectrum moving downwind; leaves also flutter: "
+      "docs/renderer-and-scenes.md, Wind in the vegetation); their pixels are moving things "
+      "of the masks. false: the vegetation stands still whatever the wind");
   }
 };
 

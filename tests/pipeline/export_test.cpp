@@ -199,13 +199,15 @@ TEST_P(ExportRoundTrip, ExportIsTheSameBytesWhateverTheThreadCount) {
       GetParam(), GetParam() == dataset::DatasetFormat::kRosbag ? 6u : 10u);
 }
 
-// A scene with movers (the crossing with its traffic) exports their masks beside the dataset:
+// A scene with movers (the crossing with its traffic, in a breeze that sways the trees) exports
+// their masks beside the dataset:
 // mask_0/NNNNNN.png for each frame and mask_0/moving_px.csv, whose share is the PNG's (read
 // back by OpenCV), the same bytes with one or two threads.
 TEST(ExportMasks, ATrafficSceneGetsAMaskPerFrameAndItsShare) {
   const fs::path root = test::unused_temp_path("export_masks");
   Scenario sc = load_scenario(test::source_dir() / "scenarios/river_crossing_traffic.yaml");
   sc.pipeline.max_frames = 5;
+  sc.water.wind.speed_mps = 4.4;  // and the vegetation swaying: the survey's breeze
   ExportOptions o;
   o.format = dataset::DatasetFormat::kKitti;
   for (int threads : {1, 2}) {
@@ -225,7 +227,7 @@ TEST(ExportMasks, ATrafficSceneGetsAMaskPerFrameAndItsShare) {
     ASSERT_FALSE(mask.empty()) << png;
     const double share = cv::countNonZero(mask) / static_cast<double>(mask.total());
     EXPECT_EQ(std::stod(cells[2]), share) << line;
-    EXPECT_GT(share, 0.001) << line;  // the moored boat is in view
+    EXPECT_GT(share, 0.05) << line;  // the moored boat and the trees
     const fs::path rel = fs::relative(png, root / "1");
     EXPECT_TRUE(slurp(png) == slurp(root / "2" / rel)) << rel;
     ++frames;

@@ -25,8 +25,10 @@
 #include "scenes/river_reach.hpp"
 #include "scenes/scene_options.hpp"
 #include "scenes/textures.hpp"
+#include "scenes/trees.hpp"
 #include "scenes/vessels.hpp"
 #include "scenes/wave_basin.hpp"
+#include "sim/wind/gusts.hpp"
 
 namespace driftlab::scenes {
 namespace {
@@ -666,6 +668,47 @@ TEST(RiverReach, VisibilitySetsTheHazeByKoschmiedersLaw) {
 // Other vessels (scene.river_reach.vessels, issue 46 item 4): each is a mover whose pose is its
 // closed-form motion, whose hull stays within its length, beam and draft, and whose options are
 // checked against the river; a reach without vessels is the scene it was.
+// The vegetation's sway weights (sim::Mesh::sway): trees and bushes bend as a cantilever's
+// first mode, h^2 of their height, scaled by their height over the reference tree's; leaves
+// flutter, wood does not; reeds bend from the foot; the rest of the reach is rigid.
+TEST(RiverReach, VegetationSwaysAndTheRestIsRigid) {
+  const auto& g = default_reach();
+  int swaying = 0;
+  for (const sim::Mesh& m : g.meshes) {
+    const bool plant = name_has(m, "tree_") || name_has(m, "bushes_") || name_has(m, "reeds");
+    if (!plant) {
+      EXPECT_TRUE(m.sway.empty()) << m.name;
+      continue;
+    }
+    ASSERT_EQ(m.sway.size(), m.vertices.size()) << m.name;
+    ++swaying;
+    const bool leaves = name_has(m, "leaves");
+    float most = 0;
+    for (const auto& w : m.sway) {
+      EXPECT_GE(w[0], 0.f) << m.name;
+      // The tallest tree's top (leaf cards may reach above it: clamped at 1 of its height).
+      EXPECT_LE(
+          w[0],
+          kTreeHeightMax * river_defaults().tree_height_m / sim::kReferenceTreeHeight_m + 1e-6)
+          << m.name;
+      if (!name_has(m, "reeds")) {
+        EXPECT_EQ(w[1], leaves ? 1.f : 0.f) << m.name;
+      }
+      most = std::max(most, w[0]);
+    }
+    EXPECT_GT(most, 0.1f) << m.name;
+  }
+  EXPECT_GT(swaying, 3);
+  // One tree, by hand: its foot does not move, its top by height / 12 m, half-way a quarter.
+  sim::Mesh stem;
+  for (double z : {0.0, -5.0, -10.0})
+    stem.vertices.push_back(sim::Vertex{1, 2, static_cast<float>(z), 0, 0, -1, 0, 0});
+  set_plant_sway(&stem, Vec3(1, 2, 0), 10.0, 0.f);
+  EXPECT_EQ(stem.sway[0][0], 0.f);
+  EXPECT_NEAR(stem.sway[1][0], 0.25 * 10 / 12, 1e-6);
+  EXPECT_NEAR(stem.sway[2][0], 10.0 / 12, 1e-6);
+}
+
 TEST(OtherVessels, MoveAsTheirOptionsSay) {
   OtherVesselOptions launch;
   launch.north_m = 70;

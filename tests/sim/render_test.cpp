@@ -16,6 +16,7 @@
 #include "core/rotation.hpp"
 #include "sim/render/mip_chain.hpp"
 #include "sim/waves/wave_field.hpp"
+#include "sim/wind/gusts.hpp"
 #include "tests/sim/render_fixtures.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -584,8 +585,8 @@ TEST(Render, MoversMaskIsWhereTheirDepthDiffersFromTheSceneWithoutThem) {
   StereoRenderer a(rig_640(), RenderOptions{}), b(rig_640(), RenderOptions{});
   a.upload(with);
   b.upload(without);
-  EXPECT_TRUE(a.has_movers());
-  EXPECT_FALSE(b.has_movers());
+  EXPECT_TRUE(a.has_moving_things());
+  EXPECT_FALSE(b.has_moving_things());
   const SE3 T_W_C = camera_at(Vec3(0, 0, -1.0));
   for (double t : {0.1, 0.8, 1.9}) {
     const TruthImages moving = a.render_truth(T_W_C, t), still = b.render_truth(T_W_C, t);
@@ -620,6 +621,55 @@ TEST(Render, MoversMaskIsWhereTheirDepthDiffersFromTheSceneWithoutThem) {
   EXPECT_NEAR(late.depth.at(u_wall, v_wall), 7.0, 0.01);
   EXPECT_EQ(late.moving.at(u_wall, v_wall + 16), 255);  // below the wall: the hull
   EXPECT_GT(late.depth.at(u_wall, v_wall + 16), 9.6);
+}
+
+// The wind in the vegetation: a sheet whose vertices sway with weight 1 is drawn, at each
+// instant, where sim::VegetationSway::sway_m puts each vertex (its edges moved downwind, east
+// here), so its mask's centroid is the centre of the pixel columns between the moved edges; it
+// is in the mask of moving things, a rigid sheet beside it is not.
+TEST(Render, SwayingSheetIsWhereItsGustsPutItAndInTheMask) {
+  SceneGeometry scene = dark_scene();
+  Mesh sheet = quad_mesh(
+      {Vec3(10, -0.5, -1.5), Vec3(10, 0.5, -1.5), Vec3(10, 0.5, -0.5), Vec3(10, -0.5, -0.5)},
+      -Vec3::UnitX(), true);
+  sheet.sway.assign(4, {1.f, 0.f});
+  scene.meshes.push_back(sheet);
+  Mesh rigid = quad_mesh(
+      {Vec3(10, -2.5, -1.5), Vec3(10, -1.5, -1.5), Vec3(10, -1.5, -0.5), Vec3(10, -2.5, -0.5)},
+      -Vec3::UnitX(), true);
+  scene.meshes.push_back(rigid);
+  WindOptions wind;
+  wind.speed_mps = 8;
+  wind.direction_deg = 90;  // towards the east: across the view
+  VegetationSway sway = vegetation_sway(wind, Rng(11));
+  sway.flutter_amplitude_m = 0;
+  StereoRenderer r(rig_640(), RenderOptions{});
+  r.upload(scene);
+  EXPECT_FALSE(r.has_moving_things());  // no wind yet
+  r.set_sway(sway);
+  EXPECT_TRUE(r.has_moving_things());
+  const SE3 T_W_C = camera_at(Vec3(0, 0, -1.0));
+  double moved = 0;
+  for (double t : {1.3, 7.1, 22.6}) {
+    const TruthImages truth = r.render_truth(T_W_C, t);
+    int n = 0, rigid_masked = 0;
+    double u = 0;
+    for (int y = 0; y < 480; ++y)
+      for (int x = 0; x < 640; ++x) {
+        if (truth.moving.at(x, y) == 0) continue;
+        if (x < 270) ++rigid_masked;
+        ++n;
+        u += x;
+      }
+    const double west = -0.5 + sway.sway_m(Eigen::Vector2d(10, -0.5), t);
+    const double east = 0.5 + sway.sway_m(Eigen::Vector2d(10, 0.5), t);
+    const double first = std::ceil(319.5 + 50 * west), last = std::ceil(319.5 + 50 * east) - 1;
+    ASSERT_GT(n, 1000) << t;
+    EXPECT_EQ(rigid_masked, 0) << t;
+    EXPECT_NEAR(u / n, (first + last) / 2, 0.02) << "t " << t;
+    moved = std::max(moved, std::abs(west + 0.5));
+  }
+  EXPECT_GT(moved * 50, 1.0);  // the gusts moved it by a pixel or more
 }
 
 TEST(Render, BadRigIsAClearError) {
