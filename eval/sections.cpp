@@ -109,6 +109,7 @@ FrameTable run_vo_covariates(const FrameTable& run, const std::string& vo,
     put("mean_depth_m", std::move(depth));
   }
   if (const auto* lost = run.column(vo + "_lost")) put("lost", *lost);
+  if (const auto* moving = run.column("moving_px")) put("moving_px", *moving);
   return out;
 }
 

@@ -52,7 +52,8 @@ std::string run_vo_of(const std::vector<std::string>& vos, const std::string& al
 /// From a run's frames.csv, the covariates the run's own evaluation of VO `vo` used: the
 /// platform's `yaw_deg`, `pitch_deg`, `roll_deg`; the VO's `NAME_features` as `inliers`
 /// (covariate f), `NAME_mean_depth_m` as `mean_depth_m` (d), both missing where the VO gave no
-/// motion (`NAME_valid` 0), and `NAME_lost` as `lost`. The run's other columns (render and
+/// motion (`NAME_valid` 0), `NAME_lost` as `lost`, and the scene's `moving_px` (the share of
+/// the image showing moving things, a covariate of every VO). The run's other columns (render and
 /// camera timings, the other VOs) are left out, as in the run's evaluation. For a frames.csv
 /// written before `NAME_features` existed (2026-11-27), f is `NAME_valid_depth_px` where that
 /// is positive (the dense VO), else `NAME_inliers`. Throws UserError naming `path` and the VOs

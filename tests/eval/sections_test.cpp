@@ -121,10 +121,11 @@ TEST(Sections, ARunsFrameTableGivesEachVoItsCovariates) {
   FrameTable run;
   run.names = {"yaw_deg",        "render_ms",           "sparse_valid",
                "sparse_inliers", "sparse_mean_depth_m", "sparse_features",
-               "sparse_lost",    "sparse_kf_valid",     "sparse_kf_inliers"};
+               "sparse_lost",    "sparse_kf_valid",     "sparse_kf_inliers",
+               "moving_px"};
   run.t_ns = {0, 1, 2};
   run.columns = {{1, 2, 3},         {9, 9, 9}, {0, 1, 0}, {0, 120, 0}, {kNaN, 21.5, kNaN},
-                 {kNaN, 118, kNaN}, {0, 0, 1}, {0, 1, 1}, {0, 80, 90}};
+                 {kNaN, 118, kNaN}, {0, 0, 1}, {0, 1, 1}, {0, 80, 90}, {0, 0.25, 0.5}};
   const std::vector<std::string> vos = run_vo_names(run);
   EXPECT_EQ(vos, (std::vector<std::string>{"sparse", "sparse_kf"}));
   EXPECT_EQ(run_vo_of(vos, "sparse"), "sparse");
@@ -135,7 +136,9 @@ TEST(Sections, ARunsFrameTableGivesEachVoItsCovariates) {
   EXPECT_EQ(run_vo_of(vos, "dense"), "");
 
   const FrameTable s = run_vo_covariates(run, "sparse", "frames.csv");
-  EXPECT_EQ(s.names, (std::vector<std::string>{"yaw_deg", "inliers", "mean_depth_m", "lost"}));
+  EXPECT_EQ(s.names,
+            (std::vector<std::string>{"yaw_deg", "inliers", "mean_depth_m", "lost", "moving_px"}));
+  EXPECT_EQ(*s.column("moving_px"), (std::vector<double>{0, 0.25, 0.5}));  // the scene's
   EXPECT_EQ(s.t_ns, run.t_ns);
   // f is the VO's own feature count, not its inliers, and missing where it gave no motion.
   EXPECT_TRUE(std::isnan((*s.column("inliers"))[0]));
@@ -146,7 +149,7 @@ TEST(Sections, ARunsFrameTableGivesEachVoItsCovariates) {
   // Before the `_features` column (2026-11-27): the inliers, or the dense VO's valid-depth
   // pixels; no `lost`.
   const FrameTable kf = run_vo_covariates(run, "sparse_kf", "frames.csv");
-  EXPECT_EQ(kf.names, (std::vector<std::string>{"yaw_deg", "inliers"}));
+  EXPECT_EQ(kf.names, (std::vector<std::string>{"yaw_deg", "inliers", "moving_px"}));
   EXPECT_TRUE(std::isnan((*kf.column("inliers"))[0]));
   EXPECT_EQ((*kf.column("inliers"))[2], 90.0);
   run.names[8] = "sparse_kf_valid_depth_px";
