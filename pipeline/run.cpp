@@ -253,7 +253,7 @@ std::vector<Track> make_tracks(const Scenario& sc, const StereoRig& rig,
 // VO's inliers and depths as the section covariates): metrics.json's algorithms and VO
 // timings, and the tables; each track's sections CSV is appended to *sections.
 std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks,
-                            const MissionTruth& mission,
+                            const MissionTruth& mission, const std::vector<double>& moving_px,
                             const std::optional<eval::PlanarReference>& overhead,
                             TrackRecords* records, std::string* sections_csv) {
   const Trajectory& camera_gt = mission.camera_gt;
@@ -275,8 +275,8 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
     // `lost`: 1 where the VO gave no motion, so each section's mean is its share of such
     // frames (the sections a lost stretch touched). The frames the camera delivered, as in
     // frames.csv, so that `driftlab eval --covariates frames.csv` finds the same covariates.
-    ft.names = {"yaw_deg", "pitch_deg", "roll_deg", "inliers", "mean_depth_m", "lost"};
-    ft.columns.resize(6);
+    ft.names = {"yaw_deg", "pitch_deg", "roll_deg", "inliers", "mean_depth_m", "lost", "moving_px"};
+    ft.columns.resize(7);
     for (std::size_t k = 0; k < camera_gt.size(); ++k) {
       if (dropped_frame(src.results[k])) continue;
       ft.t_ns.push_back(camera_gt[k].t_ns);
@@ -290,6 +290,7 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
       ft.columns[4].push_back(r.valid ? r.mean_inlier_depth_m
                                       : std::numeric_limits<double>::quiet_NaN());
       ft.columns[5].push_back(lost_track(r) ? 1.0 : 0.0);
+      ft.columns[6].push_back(moving_px[k]);
     }
     in.frames = ft;
     const eval::Evaluation e = eval::evaluate(in);
@@ -364,6 +365,7 @@ struct FrameLoop {
   int threads;
   ExternalVoStage& external;  // the exports for the external VOs
   std::vector<Track>& tracks;
+  std::vector<double>& moving_px;  // per frame (camera_gt's indices): CapturedFrame::moving_px
 };
 
 // The frame loop: every delivered frame through every track (the VOs, side by side when
@@ -388,6 +390,7 @@ double run_frame_loop(const FrameLoop& loop) {
   while (std::optional<CapturedFrame> captured = loop.source.next()) {
     const std::size_t k = captured->k;  // dropped frames never come: nothing rendered or seen
     progress.update(k);
+    loop.moving_px[k] = captured->moving_px;
     const TimeNs t = loop.stamps[k].t_stamp_ns;  // what the camera's clock wrote
     const double render_ms = captured->render_ms;
     const double exposure_ms = captured->exposure_ms;
@@ -503,8 +506,9 @@ static VisionRecord run_vision_stages(const Scenario& sc, const sim::SceneGeomet
     for (auto& t : tracks) t.estimate.push_back({stamps[first].t_stamp_ns, camera_gt[first].T_W_C});
   std::size_t dropped = 0;
   for (std::size_t k = 0; k < camera_gt.size(); ++k) dropped += stamps[k].dropped ? 1 : 0;
+  std::vector<double> moving_px(camera_gt.size(), 0.0);
   record.render_s = run_frame_loop(
-      {source, stamps, mission, first, dir, options, record.threads, external, tracks});
+      {source, stamps, mission, first, dir, options, record.threads, external, tracks, moving_px});
   add_whole_run_tracks(sc, stamps, first, mission, &external, &tracks, &record.external_vo,
                        &warnings);
   write_estimates(tracks, dir);
@@ -521,7 +525,7 @@ static VisionRecord run_vision_stages(const Scenario& sc, const sim::SceneGeomet
   // camera's reference).
   std::string report = fmt::format("# driftlab run: {}\n\n{}\n\n", sc.name, sc.description);
   std::string sections;
-  report += evaluate_tracks(sc, tracks, mission, overhead, &record.tracks, &sections);
+  report += evaluate_tracks(sc, tracks, mission, moving_px, overhead, &record.tracks, &sections);
   write_file_atomic(dir / "sections.csv", sections);
   report += report_tracking(tracks, camera_gt, &record.tracks, &warnings);
   report += compare_filters_with_raw_vo(tracks, &record.tracks, &warnings);
