@@ -15,6 +15,11 @@
 //                        sgbm_ms (SGBM + disparity refinement), alignment_ms (pyramid +
 //                        reference points and Jacobians + Levenberg-Marquardt), and their parts
 //   BM_DenseVoPaper      the same, river paper's plain method
+//   BM_DenseVo1024/threads:N/3way:M
+//                        BM_DenseVo through the river scenarios' Bumblebee2 (1024x768) with N
+//                        threads in OpenCV's pool, M = 1: sgbm_mode 3way; one_core_ms adds the
+//                        stages (the wall overlaps two of them: with N = 1 it is the work of a
+//                        frame on one core)
 //   BM_Sgbm              cv::StereoSGBM alone on the full pair (the paper's method)
 //   BM_SgbmShrunk        cv::StereoSGBM alone on the pair shrunk by sgbm_downsample (default 2)
 //   BM_SgbmRefined       the default: SGBM on the shrunk pair + our Lucas-Kanade refinement
@@ -57,6 +62,14 @@ const test::Sequence& sequence() {
   return s;
 }
 
+// The same bank and motion through the river paper's Bumblebee2 (1024x768, 817 px).
+const test::Sequence& sequence_1024() {
+  static const test::Sequence s =
+      test::make_sequence(test::river_bank_scene_640(), test::bumblebee2_rig(),
+                          test::turning_poses(static_cast<int>(kFrames), 0.5, 1.0));
+  return s;
+}
+
 // 0 1 2 ... 7 6 5 ... 1 0 1 ...
 std::size_t ping_pong(std::size_t i) {
   const std::size_t period = 2 * (kFrames - 1);
@@ -64,8 +77,7 @@ std::size_t ping_pong(std::size_t i) {
   return k < kFrames ? k : period - k;
 }
 
-SE3 true_motion(std::size_t from, std::size_t to) {
-  const test::Sequence& s = sequence();
+SE3 true_motion(const test::Sequence& s, std::size_t from, std::size_t to) {
   return s.T_scene_cam[from].inverse() * s.T_scene_cam[to];
 }
 
@@ -73,12 +85,13 @@ SE3 true_motion(std::size_t from, std::size_t to) {
 struct ErrorCounters {
   double t_sum = 0, r_sum = 0, t_max = 0, r_max = 0;
   int n = 0, invalid = 0;
+  const test::Sequence& seq;
   void add(bool valid, const SE3& T_prev_curr, std::size_t from, std::size_t to) {
     if (!valid) {
       ++invalid;
       return;
     }
-    const auto e = test::motion_error(T_prev_curr, true_motion(from, to));
+    const auto e = test::motion_error(T_prev_curr, true_motion(seq, from, to));
     t_sum += e.translation_m;
     r_sum += e.rotation_rad;
     t_max = std::max(t_max, e.translation_m);
@@ -94,14 +107,14 @@ struct ErrorCounters {
   }
 };
 
-void run_vo(benchmark::State& state, const DenseVoOptions& options) {
-  cv::setNumThreads(1);
-  const test::Sequence& seq = sequence();
+void run_vo(benchmark::State& state, const DenseVoOptions& options,
+            const test::Sequence& seq = sequence(), int threads = 1) {
+  cv::setNumThreads(threads);
   DenseStereoOdometry vo(seq.rig, options, RngStreams(1).stream("vo.dense"));
   vo.process(seq.frames[0]);
   std::size_t i = 1;
   double pyramid = 0, sgbm = 0, reference = 0, lm = 0, points = 0;
-  ErrorCounters errors;
+  ErrorCounters errors{.seq = seq};
   for (auto _ : state) {
     const std::size_t from = ping_pong(i - 1), to = ping_pong(i);
     ++i;
@@ -122,8 +135,13 @@ void run_vo(benchmark::State& state, const DenseVoOptions& options) {
   state.counters["reference_ms"] = benchmark::Counter(reference, avg);
   state.counters["lm_ms"] = benchmark::Counter(lm, avg);
   state.counters["ref_points"] = benchmark::Counter(points, avg);
+  // The work of a frame on one core: the stages' times added (two of them overlap in the wall).
+  state.counters["one_core_ms"] = benchmark::Counter(pyramid + sgbm + reference + lm, avg);
   errors.report(state);
-  state.SetLabel("640x480");
+  state.SetLabel(std::to_string(seq.rig.camera.width) + "x" +
+                 std::to_string(seq.rig.camera.height) + ", " + std::to_string(threads) +
+                 (threads == 1 ? " thread" : " threads"));
+  cv::setNumThreads(1);
 }
 
 void BM_DenseVo(benchmark::State& state) { run_vo(state, DenseVoOptions{}); }
@@ -131,6 +149,18 @@ BENCHMARK(BM_DenseVo)->Unit(benchmark::kMillisecond);
 
 void BM_DenseVoPaper(benchmark::State& state) { run_vo(state, DenseVoOptions::paper()); }
 BENCHMARK(BM_DenseVoPaper)->Unit(benchmark::kMillisecond);
+
+// The whole VO at the Bumblebee2's 1024x768, as in the river scenarios, with OpenCV's pool (the
+// VO's loops run on it) at 1 to 16 threads; the defaults, and with sgbm_mode 3way.
+void BM_DenseVo1024(benchmark::State& state) {
+  DenseVoOptions o;
+  if (state.range(1) == 1) o.sgbm_mode = DenseSgbmMode::kThreeWay;
+  run_vo(state, o, sequence_1024(), static_cast<int>(state.range(0)));
+}
+BENCHMARK(BM_DenseVo1024)
+    ->ArgsProduct({{1, 2, 4, 8, 16}, {0, 1}})
+    ->ArgNames({"threads", "3way"})
+    ->Unit(benchmark::kMillisecond);
 
 void run_disparity(benchmark::State& state, const dense::DisparityOptions& options) {
   cv::setNumThreads(1);
@@ -210,7 +240,7 @@ void BM_DenseAlignment(benchmark::State& state) {
   pyr[0].build(seq.frames[0].left, o.pyramid_blur_sigma_px);
   dense::build_reference(pyr[0], dep.disparity[0], fB, sel, &ref[0]);
   std::size_t i = 1;
-  ErrorCounters errors;
+  ErrorCounters errors{.seq = seq};
   SE3 velocity;  // constant-velocity guess, as the VO does
   for (auto _ : state) {
     const std::size_t from = ping_pong(i - 1), to = ping_pong(i);
@@ -253,7 +283,7 @@ void BM_RgbdOdometry(benchmark::State& state) {
   cv::Ptr<cv::rgbd::OdometryFrame> prev = frame(0);
   odo->prepareFrameCache(prev, cv::rgbd::OdometryFrame::CACHE_ALL);
   std::size_t i = 1;
-  ErrorCounters errors;
+  ErrorCounters errors{.seq = seq};
   double cache_ms = 0, compute_ms = 0;
   for (auto _ : state) {
     const std::size_t from = ping_pong(i - 1), to = ping_pong(i);

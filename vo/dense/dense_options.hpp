@@ -29,14 +29,20 @@ constexpr auto enum_table(DenseMethod) {
                     std::pair{DenseMethod::kExtended, "extended"}};
 }
 
-/// cv::StereoSGBM's mode. Only the modes whose output does not depend on OpenCV's thread count
-/// are offered (MODE_SGBM_3WAY splits the image into per-thread stripes).
+/// cv::StereoSGBM's mode. Every mode here gives the same disparity whatever OpenCV's thread count:
+/// MODE_SGBM_3WAY splits the image into 4 stripes of rows and MODE_HH4 into its own pieces, both
+/// fixed by OpenCV (calib3d/src/stereosgbm.cpp, "to make the results fully reproducible").
 enum class DenseSgbmMode {
-  kSgbm,  ///< MODE_SGBM: 5 path directions, single pass
-  kHh,    ///< MODE_HH: full 8 directions, two passes (Hirschmueller 2008); slower
+  kSgbm,      ///< MODE_SGBM: 5 path directions, single pass, one thread
+  kHh,        ///< MODE_HH: full 8 directions, two passes (Hirschmueller 2008); slower
+  kThreeWay,  ///< MODE_SGBM_3WAY: 3 directions (along the row both ways, down), 4 stripes in
+              ///< parallel; the fastest
+  kHh4,       ///< MODE_HH4: 8 directions, in parallel
 };
 constexpr auto enum_table(DenseSgbmMode) {
-  return std::array{std::pair{DenseSgbmMode::kSgbm, "sgbm"}, std::pair{DenseSgbmMode::kHh, "hh"}};
+  return std::array{std::pair{DenseSgbmMode::kSgbm, "sgbm"}, std::pair{DenseSgbmMode::kHh, "hh"},
+                    std::pair{DenseSgbmMode::kThreeWay, "3way"},
+                    std::pair{DenseSgbmMode::kHh4, "hh4"}};
 }
 
 struct DenseVoOptions {
@@ -157,7 +163,10 @@ struct DenseVoOptions {
     a("sgbm_speckle_range_px", sgbm_speckle_range_px,
       "Largest disparity variation inside one connected region of the speckle filter [px]",
       yaml::in_range(0, 64));
-    a("sgbm_mode", sgbm_mode, "cv::StereoSGBM mode (deterministic modes only)");
+    a("sgbm_mode", sgbm_mode,
+      "cv::StereoSGBM mode: sgbm (5 directions), hh (8, two passes), 3way (3, in 4 stripes "
+      "of rows on OpenCV's threads: the fastest), hh4 (8, on OpenCV's threads); each gives the "
+      "same bytes at any thread count");
     a("sgbm_downsample", sgbm_downsample,
       "extended, with refine_disparity: run SGBM on the pair shrunk by this factor (pixel "
       "averaging) over sgbm_num_disparities_px / this disparities, and take its disparity back "

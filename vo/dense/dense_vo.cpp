@@ -31,6 +31,20 @@ struct AlignOutcome {
 
 namespace dense {
 
+int sgbm_mode(DenseSgbmMode mode) {
+  switch (mode) {
+    case DenseSgbmMode::kSgbm:
+      return cv::StereoSGBM::MODE_SGBM;
+    case DenseSgbmMode::kHh:
+      return cv::StereoSGBM::MODE_HH;
+    case DenseSgbmMode::kThreeWay:
+      return cv::StereoSGBM::MODE_SGBM_3WAY;
+    case DenseSgbmMode::kHh4:
+      return cv::StereoSGBM::MODE_HH4;
+  }
+  throw InternalError("sgbm_mode: unknown DenseSgbmMode");
+}
+
 DisparityOptions disparity_options(const DenseVoOptions& o) {
   DisparityOptions d;
   d.num_disparities = o.sgbm_num_disparities_px;
@@ -42,7 +56,7 @@ DisparityOptions disparity_options(const DenseVoOptions& o) {
   d.uniqueness_ratio = o.sgbm_uniqueness_ratio_pct;
   d.speckle_window = o.sgbm_speckle_window_px;
   d.speckle_range = o.sgbm_speckle_range_px;
-  d.full_dp = o.sgbm_mode == DenseSgbmMode::kHh;
+  d.mode = sgbm_mode(o.sgbm_mode);
   d.downsample = o.effective_sgbm_downsample();
   d.refine_iterations = o.use_refine_disparity() ? o.refine_iterations : 0;
   d.refine_window = o.refine_window_px;

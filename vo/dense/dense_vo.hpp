@@ -50,6 +50,8 @@
 namespace driftlab::vo {
 
 namespace dense {
+/// cv::StereoSGBM's mode constant for a DenseSgbmMode.
+int sgbm_mode(DenseSgbmMode mode);
 /// The disparity estimator's settings that a dense VO with these options uses.
 DisparityOptions disparity_options(const DenseVoOptions& options);
 /// Which reference pixels a dense VO with these options keeps.

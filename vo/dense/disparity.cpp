@@ -7,8 +7,22 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.hpp"
+#include "vo/dense/pieces.hpp"
 
 namespace driftlab::vo::dense {
+
+namespace {
+
+// cv::boxFilter with zeros beyond the image, in pieces of rows. Its running column sums start
+// afresh in each piece; the pieces are the same at any thread count.
+void box_filter(const cv::Mat& src, cv::Mat* dst, int window, bool normalize) {
+  filter_in_row_pieces(src, dst, CV_32FC1, [&](const cv::Mat& in, cv::Mat& out) {
+    cv::boxFilter(in, out, CV_32F, cv::Size(window, window), cv::Point(-1, -1), normalize,
+                  cv::BORDER_CONSTANT);
+  });
+}
+
+}  // namespace
 
 int searched_disparities(const DisparityOptions& options) {
   const int per_level = (options.num_disparities + options.downsample - 1) / options.downsample;
@@ -21,8 +35,7 @@ DisparityEstimator::DisparityEstimator(const DisparityOptions& options) : option
   sgbm_ = cv::StereoSGBM::create(
       /*minDisparity=*/0, searched_disparities(options), options.block_size, options.p1, options.p2,
       options.disp12_max_diff, options.pre_filter_cap, options.uniqueness_ratio,
-      options.speckle_window, options.speckle_range,
-      options.full_dp ? cv::StereoSGBM::MODE_HH : cv::StereoSGBM::MODE_SGBM);
+      options.speckle_window, options.speckle_range, options.mode);
 }
 
 void DisparityEstimator::match(const cv::Mat& left8, const cv::Mat& right8, cv::Mat* disparity) {
@@ -39,11 +52,11 @@ void DisparityEstimator::match(const cv::Mat& left8, const cv::Mat& right8, cv::
   const float scale = static_cast<float>(left8.cols) / static_cast<float>(raw_.cols) / 16.0f;
   cv::Mat& out = shrink ? small_disparity_ : *disparity;
   out.create(raw_.size(), CV_32FC1);
-  for (int v = 0; v < raw_.rows; ++v) {
+  for_each_row(raw_.rows, [&](int v) {
     const std::int16_t* r = raw_.ptr<std::int16_t>(v);
     float* d = out.ptr<float>(v);
     for (int u = 0; u < raw_.cols; ++u) d[u] = r[u] > 0 ? r[u] * scale : 0.0f;
-  }
+  });
   if (shrink) cv::resize(out, *disparity, left8.size(), 0.0, 0.0, cv::INTER_NEAREST);
 }
 
@@ -63,7 +76,7 @@ void DisparityEstimator::linearise(const cv::Mat& left_f32, const cv::Mat& dispa
   ge_.create(H, W, CV_32FC1);
   gg_.create(H, W, CV_32FC1);
   ee_.create(H, W, CV_32FC1);
-  for (int v = 0; v < H; ++v) {
+  for_each_row(H, [&](int v) {
     const float* d = disparity.ptr<float>(v);
     const float* L = left_f32.ptr<float>(v);
     const float* R = right_f32_.ptr<float>(v);
@@ -86,19 +99,18 @@ void DisparityEstimator::linearise(const cv::Mat& left_f32, const cv::Mat& dispa
       gg[u] = g * g;
       ee[u] = e * e;
     }
-  }
+  });
 }
 
 void DisparityEstimator::refine(const cv::Mat& left_f32, cv::Mat* disparity) {
   const int W = disparity->cols, H = disparity->rows;
-  const cv::Size window(options_.refine_window, options_.refine_window);
   // Windows with less gradient energy than 1 grey/px on every pixel keep SGBM's value.
   const float min_energy = static_cast<float>(options_.refine_window * options_.refine_window);
   for (int it = 0; it < options_.refine_iterations; ++it) {
     linearise(left_f32, *disparity);
-    cv::boxFilter(ge_, ge_sum_, CV_32F, window, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
-    cv::boxFilter(gg_, gg_sum_, CV_32F, window, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
-    for (int v = 0; v < H; ++v) {
+    box_filter(ge_, &ge_sum_, options_.refine_window, false);
+    box_filter(gg_, &gg_sum_, options_.refine_window, false);
+    for_each_row(H, [&](int v) {
       float* d = disparity->ptr<float>(v);
       const float* sge = ge_sum_.ptr<float>(v);
       const float* sgg = gg_sum_.ptr<float>(v);
@@ -106,23 +118,23 @@ void DisparityEstimator::refine(const cv::Mat& left_f32, cv::Mat* disparity) {
         if (!(d[u] > 0.0f) || !(sgg[u] > min_energy)) continue;
         d[u] += std::clamp(-sge[u] / sgg[u], -0.5f, 0.5f);
       }
-    }
+    });
   }
   // A match is kept when the refinement moved it little and the refined disparity brings the
   // window's right-image pixels onto the left ones (RMS residual within max_residual).
   linearise(left_f32, *disparity);
-  cv::boxFilter(ee_, ee_mean_, CV_32F, window, cv::Point(-1, -1), true, cv::BORDER_CONSTANT);
+  box_filter(ee_, &ee_mean_, options_.refine_window, true);
   const float max_change = static_cast<float>(options_.refine_max_change);
   const float max_ee =
       static_cast<float>(options_.refine_max_residual * options_.refine_max_residual);
-  for (int v = 0; v < H; ++v) {
+  for_each_row(H, [&](int v) {
     float* d = disparity->ptr<float>(v);
     const float* d0 = sgbm_disparity_.ptr<float>(v);
     const float* mean_ee = ee_mean_.ptr<float>(v);
     for (int u = 0; u < W; ++u)
       if (d[u] > 0.0f && (std::abs(d[u] - d0[u]) > max_change || !(mean_ee[u] <= max_ee)))
         d[u] = 0.0f;
-  }
+  });
 }
 
 }  // namespace driftlab::vo::dense

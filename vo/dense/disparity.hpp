@@ -19,7 +19,7 @@ struct DisparityOptions {
   int uniqueness_ratio = 10;
   int speckle_window = 100;
   int speckle_range = 2;
-  bool full_dp = false;  ///< MODE_HH instead of MODE_SGBM
+  int mode = cv::StereoSGBM::MODE_SGBM;  ///< cv::StereoSGBM's mode
   /// SGBM runs on the pair shrunk by this factor (cv::INTER_AREA) with num_disparities /
   /// downsample disparities (rounded up to a multiple of 16); its disparity is scaled back to
   /// full resolution by nearest-neighbour lookup, for the refinement to make sub-pixel. 1: SGBM

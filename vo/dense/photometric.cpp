@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.hpp"
+#include "vo/dense/pieces.hpp"
 #include "vo/stereo_odometry.hpp"
 
 namespace driftlab::vo::dense {
@@ -64,8 +65,10 @@ void Pyramid::build(const cv::Mat& gray8, double blur_sigma_px, bool area_downsc
   if (blur_sigma_px > 0.0) {
     // Kernel truncated at 3 sigma: 19 taps for the paper's sigma of 3.
     const int k = 2 * static_cast<int>(std::ceil(3.0 * blur_sigma_px)) + 1;
-    cv::GaussianBlur(full, blurred, cv::Size(k, k), blur_sigma_px, blur_sigma_px,
-                     cv::BORDER_REFLECT_101);
+    filter_in_row_pieces(full, &blurred, CV_32FC1, [&](const cv::Mat& in, cv::Mat& out) {
+      cv::GaussianBlur(in, out, cv::Size(k, k), blur_sigma_px, blur_sigma_px,
+                       cv::BORDER_REFLECT_101);
+    });
     src = &blurred;
   }
   for (std::size_t l = 0; l + 1 < cameras.size(); ++l)
@@ -111,6 +114,102 @@ inline void add_point(float u, float v, float gx, float gy, float i, float D, co
 
 }  // namespace
 
+namespace {
+
+// The full-resolution pixels of rows [v0, v1) (1 <= v0, v1 <= H - 1) into `sel`: the texture mask,
+// the frame's texture counts and the points of rows above v_end.
+void select_full_rows(const Pyramid& pyramid, const cv::Mat& disparity, float fB,
+                      const RefSelection& selection, int v_end, int v0, int v1, cv::Mat* textured,
+                      RowsSelected* sel) {
+  const LevelCamera& c = pyramid.cameras.back();
+  const cv::Mat& I = pyramid.images.back();
+  const int W = disparity.cols;
+  const float min_d = static_cast<float>(selection.min_disparity_px);
+  const float g2_textured = static_cast<float>(selection.min_gradient * selection.min_gradient);
+  for (int v = v0; v < v1; ++v) {
+    const float* row = I.ptr<float>(v);
+    const float* up = I.ptr<float>(v - 1);
+    const float* down = I.ptr<float>(v + 1);
+    const float* d = disparity.ptr<float>(v);
+    std::uint8_t* mask = textured->ptr<std::uint8_t>(v);
+    mask[0] = mask[W - 1] = 0;
+    const bool in_rows = v < v_end;
+    for (int u = 1; u < W - 1; ++u) {
+      const float gx = 0.5f * (row[u + 1] - row[u - 1]);
+      const float gy = 0.5f * (down[u] - up[u]);
+      const bool is_textured = gx * gx + gy * gy >= g2_textured;
+      const bool has_depth = d[u] >= min_d;
+      mask[u] = is_textured ? 1 : 0;
+      sel->textured += is_textured ? 1 : 0;
+      sel->both += is_textured && has_depth ? 1 : 0;
+      if (!in_rows || !has_depth || (selection.gradient_mask && !is_textured)) continue;
+      add_point(static_cast<float>(u), static_cast<float>(v), gx, gy, row[u], d[u], c, fB,
+                &sel->level);
+      sel->level.textured.push_back(is_textured ? 1 : 0);
+    }
+  }
+}
+
+// The pixels of rows [v0, v1) of coarse level l into `sel`: those whose full-resolution block
+// has depth everywhere (and, with the mask, texture on half of it), at the block's mean
+// disparity.
+void select_coarse_rows(const Pyramid& pyramid, std::size_t l, const cv::Mat& disparity, float fB,
+                        const RefSelection& selection, const Reference& ref, int v0, int v1,
+                        RowsSelected* sel) {
+  const LevelCamera& c = pyramid.cameras[l];
+  const cv::Mat& I = pyramid.images[l];
+  const float min_d = static_cast<float>(selection.min_disparity_px);
+  for (int v = v0; v < v1; ++v) {
+    const float* row = I.ptr<float>(v);
+    const float* up = I.ptr<float>(v - 1);
+    const float* down = I.ptr<float>(v + 1);
+    const int r0 = ref.row_first[static_cast<std::size_t>(v)];
+    const int r1 = ref.row_last[static_cast<std::size_t>(v)];
+    for (int u = 1; u < c.width - 1; ++u) {
+      const int c0 = ref.col_first[static_cast<std::size_t>(u)];
+      const int c1 = ref.col_last[static_cast<std::size_t>(u)];
+      float sum = 0.0f;
+      int n_textured = 0;
+      bool all_valid = true;
+      for (int y = r0; y <= r1 && all_valid; ++y) {
+        const float* d = disparity.ptr<float>(y);
+        const std::uint8_t* mask = ref.textured.ptr<std::uint8_t>(y);
+        for (int x = c0; x <= c1; ++x) {
+          if (!(d[x] >= min_d)) {
+            all_valid = false;
+            break;
+          }
+          sum += d[x];
+          n_textured += mask[x];
+        }
+      }
+      const int n = (r1 - r0 + 1) * (c1 - c0 + 1);
+      if (!all_valid || (selection.gradient_mask && 2 * n_textured < n)) continue;
+      const float gx = 0.5f * (row[u + 1] - row[u - 1]);
+      const float gy = 0.5f * (down[u] - up[u]);
+      add_point(static_cast<float>(u), static_cast<float>(v), gx, gy, row[u],
+                sum / static_cast<float>(n), c, fB, &sel->level);
+    }
+  }
+}
+
+// Rows [first, last) of a level selected in pieces on OpenCV's threads, each piece into its own
+// scratch, then appended in row order: the points of a serial pass, in its order.
+template <class Select>
+void select_rows(int first, int last, Reference* ref, RefLevel* level, const Select& select) {
+  std::vector<RowsSelected>& pieces = ref->pieces;
+  pieces.resize(kRowPieces);
+  for (RowsSelected& p : pieces) p.clear();
+  const std::size_t rows = static_cast<std::size_t>(std::max(last - first, 0));
+  for_each_piece(rows, kRowPieces, [&](std::size_t k, std::size_t r0, std::size_t r1) {
+    select(first + static_cast<int>(r0), first + static_cast<int>(r1), &pieces[k]);
+  });
+  level->clear();
+  for (const RowsSelected& p : pieces) level->append(p.level);
+}
+
+}  // namespace
+
 void build_reference(const Pyramid& pyramid, const cv::Mat& disparity, double baseline_fx,
                      const RefSelection& selection, Reference* out) {
   DRIFTLAB_DEMAND(disparity.type() == CV_32FC1);
@@ -120,100 +219,43 @@ void build_reference(const Pyramid& pyramid, const cv::Mat& disparity, double ba
   out->levels.resize(n_levels);
   const float min_d = static_cast<float>(selection.min_disparity_px);
   const float fB = static_cast<float>(baseline_fx);
-  const float g2_textured = static_cast<float>(selection.min_gradient * selection.min_gradient);
 
-  int valid = 0;
-  for (int v = 0; v < H; ++v) {
+  std::vector<int> valid(static_cast<std::size_t>(H), 0);
+  for_each_row(H, [&](int v) {
     const float* d = disparity.ptr<float>(v);
-    for (int u = 0; u < W; ++u) valid += d[u] >= min_d ? 1 : 0;
-  }
-  out->valid_depth_pixels = valid;
+    int n = 0;
+    for (int u = 0; u < W; ++u) n += d[u] >= min_d ? 1 : 0;
+    valid[static_cast<std::size_t>(v)] = n;
+  });
+  out->valid_depth_pixels = 0;
+  for (const int n : valid) out->valid_depth_pixels += n;
 
   // Full resolution first (the last level; validation requires scale 1 last): one disparity
   // per pixel, the texture mask and the frame's texture statistics.
-  {
-    const LevelCamera& c = pyramid.cameras.back();
-    const cv::Mat& I = pyramid.images.back();
-    RefLevel& level = out->levels.back();
-    level.clear();
-    out->textured.create(H, W, CV_8UC1);
-    out->textured.row(0).setTo(0);
-    out->textured.row(H - 1).setTo(0);
-    const int v_end =
-        std::min(H - 1, static_cast<int>(std::ceil((1.0 - selection.lower_mask_fraction) * H)));
-    int textured = 0, both = 0;
-    for (int v = 1; v < H - 1; ++v) {
-      const float* row = I.ptr<float>(v);
-      const float* up = I.ptr<float>(v - 1);
-      const float* down = I.ptr<float>(v + 1);
-      const float* d = disparity.ptr<float>(v);
-      std::uint8_t* mask = out->textured.ptr<std::uint8_t>(v);
-      mask[0] = mask[W - 1] = 0;
-      const bool in_rows = v < v_end;
-      for (int u = 1; u < W - 1; ++u) {
-        const float gx = 0.5f * (row[u + 1] - row[u - 1]);
-        const float gy = 0.5f * (down[u] - up[u]);
-        const bool is_textured = gx * gx + gy * gy >= g2_textured;
-        const bool has_depth = d[u] >= min_d;
-        mask[u] = is_textured ? 1 : 0;
-        textured += is_textured ? 1 : 0;
-        both += is_textured && has_depth ? 1 : 0;
-        if (!in_rows || !has_depth || (selection.gradient_mask && !is_textured)) continue;
-        add_point(static_cast<float>(u), static_cast<float>(v), gx, gy, row[u], d[u], c, fB,
-                  &level);
-        level.textured.push_back(is_textured ? 1 : 0);
-      }
-    }
-    out->textured_pixels = textured;
-    out->textured_depth_pixels = both;
+  out->textured.create(H, W, CV_8UC1);
+  out->textured.row(0).setTo(0);
+  out->textured.row(H - 1).setTo(0);
+  const int v_end =
+      std::min(H - 1, static_cast<int>(std::ceil((1.0 - selection.lower_mask_fraction) * H)));
+  select_rows(1, H - 1, out, &out->levels.back(), [&](int v0, int v1, RowsSelected* sel) {
+    select_full_rows(pyramid, disparity, fB, selection, v_end, v0, v1, &out->textured, sel);
+  });
+  out->textured_pixels = out->textured_depth_pixels = 0;
+  for (const RowsSelected& p : out->pieces) {
+    out->textured_pixels += p.textured;
+    out->textured_depth_pixels += p.both;
   }
 
-  std::vector<int>& col_first = out->col_first;
-  std::vector<int>& col_last = out->col_last;
-  std::vector<int>& row_first = out->row_first;
-  std::vector<int>& row_last = out->row_last;
   for (std::size_t l = 0; l + 1 < n_levels; ++l) {
     const LevelCamera& c = pyramid.cameras[l];
-    const cv::Mat& I = pyramid.images[l];
-    RefLevel& level = out->levels[l];
-    level.clear();
-    cover(c.width, W, c.sx, &col_first, &col_last);
-    cover(c.height, H, c.sy, &row_first, &row_last);
-    const int v_end =
+    cover(c.width, W, c.sx, &out->col_first, &out->col_last);
+    cover(c.height, H, c.sy, &out->row_first, &out->row_last);
+    const int level_end =
         std::min(c.height - 1,
                  static_cast<int>(std::ceil((1.0 - selection.lower_mask_fraction) * c.height)));
-    for (int v = 1; v < v_end; ++v) {
-      const float* row = I.ptr<float>(v);
-      const float* up = I.ptr<float>(v - 1);
-      const float* down = I.ptr<float>(v + 1);
-      const int r0 = row_first[static_cast<std::size_t>(v)];
-      const int r1 = row_last[static_cast<std::size_t>(v)];
-      for (int u = 1; u < c.width - 1; ++u) {
-        const int c0 = col_first[static_cast<std::size_t>(u)];
-        const int c1 = col_last[static_cast<std::size_t>(u)];
-        float sum = 0.0f;
-        int n_textured = 0;
-        bool all_valid = true;
-        for (int y = r0; y <= r1 && all_valid; ++y) {
-          const float* d = disparity.ptr<float>(y);
-          const std::uint8_t* mask = out->textured.ptr<std::uint8_t>(y);
-          for (int x = c0; x <= c1; ++x) {
-            if (!(d[x] >= min_d)) {
-              all_valid = false;
-              break;
-            }
-            sum += d[x];
-            n_textured += mask[x];
-          }
-        }
-        const int n = (r1 - r0 + 1) * (c1 - c0 + 1);
-        if (!all_valid || (selection.gradient_mask && 2 * n_textured < n)) continue;
-        const float gx = 0.5f * (row[u + 1] - row[u - 1]);
-        const float gy = 0.5f * (down[u] - up[u]);
-        add_point(static_cast<float>(u), static_cast<float>(v), gx, gy, row[u],
-                  sum / static_cast<float>(n), c, fB, &level);
-      }
-    }
+    select_rows(1, level_end, out, &out->levels[l], [&](int v0, int v1, RowsSelected* sel) {
+      select_coarse_rows(pyramid, l, disparity, fB, selection, *out, v0, v1, sel);
+    });
   }
 }
 
@@ -236,46 +278,55 @@ int Aligner::warp(const RefLevel& level, const cv::Mat& image, const LevelCamera
   const std::size_t stride = image.step1();
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   float* out = residuals->data();
-  int used = 0;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const RefPoint& p = points[i];
-    // Eq. (6), G = R P + T, then Eq. (7).
-    const float qx = R(0, 0) * p.x + R(0, 1) * p.y + R(0, 2) * p.z + t.x();
-    const float qy = R(1, 0) * p.x + R(1, 1) * p.y + R(1, 2) * p.z + t.y();
-    const float qz = R(2, 0) * p.x + R(2, 1) * p.y + R(2, 2) * p.z + t.z();
-    const float iz = 1.0f / qz;
-    const float u = fx * qx * iz + cx, v = fy * qy * iz + cy;
-    if (!(qz > 1e-3f) || !(u >= 0.0f && u < umax && v >= 0.0f && v < vmax)) {
-      out[i] = kNaN;
-      continue;
-    }
-    // Eq. (9)'s residual: the current image at the warped pixel (Eq. (8)), bilinear, minus the
-    // reference.
-    const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
-    const float ax = u - static_cast<float>(x0), ay = v - static_cast<float>(y0);
-    const float* q0 = base + static_cast<std::size_t>(y0) * stride + x0;
-    const float* q1 = q0 + stride;
-    const float top = q0[0] + ax * (q0[1] - q0[0]);
-    const float bottom = q1[0] + ax * (q1[1] - q1[0]);
-    out[i] = top + ay * (bottom - top) - p.intensity;
-    ++used;
-  }
   // The step-acceptance cost: r^2 (least squares) or a bounded surrogate of the
   // t-distribution's negative log-likelihood with the same quadratic core (its log would cost
-  // more than the warp itself). A separate branch-free pass, so that it vectorises.
+  // more than the warp itself).
   const float inv_nu_s2 =
       options_.robust ? static_cast<float>(1.0 / (options_.t_dof * std::max(sigma2, 1e-12))) : 0.0f;
-  double sum = 0.0;
   constexpr std::size_t kBlock = 1024;
-  for (std::size_t begin = 0; begin < points.size(); begin += kBlock) {
-    const std::size_t end = std::min(points.size(), begin + kBlock);
-    float block = 0.0f;
+  const std::size_t n_blocks = (points.size() + kBlock - 1) / kBlock;
+  std::vector<float> block_cost(n_blocks);
+  std::vector<int> block_used(n_blocks);
+  for_each_block(points.size(), kBlock, [&](std::size_t b, std::size_t begin, std::size_t end) {
+    int used = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+      const RefPoint& p = points[i];
+      // Eq. (6), G = R P + T, then Eq. (7).
+      const float qx = R(0, 0) * p.x + R(0, 1) * p.y + R(0, 2) * p.z + t.x();
+      const float qy = R(1, 0) * p.x + R(1, 1) * p.y + R(1, 2) * p.z + t.y();
+      const float qz = R(2, 0) * p.x + R(2, 1) * p.y + R(2, 2) * p.z + t.z();
+      const float iz = 1.0f / qz;
+      const float u = fx * qx * iz + cx, v = fy * qy * iz + cy;
+      if (!(qz > 1e-3f) || !(u >= 0.0f && u < umax && v >= 0.0f && v < vmax)) {
+        out[i] = kNaN;
+        continue;
+      }
+      // Eq. (9)'s residual: the current image at the warped pixel (Eq. (8)), bilinear, minus
+      // the reference.
+      const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
+      const float ax = u - static_cast<float>(x0), ay = v - static_cast<float>(y0);
+      const float* q0 = base + static_cast<std::size_t>(y0) * stride + x0;
+      const float* q1 = q0 + stride;
+      const float top = q0[0] + ax * (q0[1] - q0[0]);
+      const float bottom = q1[0] + ax * (q1[1] - q1[0]);
+      out[i] = top + ay * (bottom - top) - p.intensity;
+      ++used;
+    }
+    // A separate branch-free pass over the block, so that it vectorises.
+    float sum = 0.0f;
     for (std::size_t i = begin; i < end; ++i) {
       const float r = out[i];
       const float rho = r * r / (1.0f + r * r * inv_nu_s2);
-      block += r == r ? rho : 0.0f;  // NaN: not compared
+      sum += r == r ? rho : 0.0f;  // NaN: not compared
     }
-    sum += block;
+    block_cost[b] = sum;
+    block_used[b] = used;
+  });
+  double sum = 0.0;
+  int used = 0;
+  for (std::size_t b = 0; b < n_blocks; ++b) {
+    sum += block_cost[b];
+    used += block_used[b];
   }
   *cost = sum / std::max(used, 1);
   return used;
@@ -287,21 +338,23 @@ double Aligner::estimate_sigma2(const std::vector<float>& residuals, int used,
   // point iterated from the previous scale; 1% is far below what changes the weights.
   const float nf = static_cast<float>(options_.t_dof);
   constexpr double kFloor = 1e-4;  // (0.01 grey)^2: exact alignments have zero residuals
+  constexpr std::size_t kBlock = 1024;
+  std::vector<float> block_sum((residuals.size() + kBlock - 1) / kBlock);
   sigma2 = std::max(sigma2, kFloor);
   for (int it = 0; it < 5; ++it) {
     const float inv = static_cast<float>(1.0 / sigma2);
+    for_each_block(residuals.size(), kBlock,
+                   [&](std::size_t b, std::size_t begin, std::size_t end) {
+                     float block = 0.0f;
+                     for (std::size_t i = begin; i < end; ++i) {
+                       const float r = residuals[i];
+                       const float term = r * r * (nf + 1.0f) / (nf + r * r * inv);
+                       block += r == r ? term : 0.0f;  // NaN: not compared
+                     }
+                     block_sum[b] = block;
+                   });
     double sum = 0.0;
-    constexpr std::size_t kBlock = 1024;
-    for (std::size_t begin = 0; begin < residuals.size(); begin += kBlock) {
-      const std::size_t end = std::min(residuals.size(), begin + kBlock);
-      float block = 0.0f;
-      for (std::size_t i = begin; i < end; ++i) {
-        const float r = residuals[i];
-        const float term = r * r * (nf + 1.0f) / (nf + r * r * inv);
-        block += r == r ? term : 0.0f;  // NaN: not compared
-      }
-      sum += block;
-    }
+    for (const float block : block_sum) sum += block;
     const double next = std::max(sum / std::max(used, 1), kFloor);
     const bool done = std::abs(next - sigma2) < 1e-2 * sigma2;
     sigma2 = next;
@@ -315,20 +368,22 @@ void Aligner::normal_equations(const RefLevel& level, const std::vector<float>& 
   // Per point, with a = J[0..3] and b = (J[4], J[5], r, 0): the products w a a_c, w b a_c
   // (c < 4) and w b b_c (c < 3) hold every entry of w [J r]^T [J r] once, in 11 packet
   // multiply-adds. Sums run in float over blocks of points and in double across blocks: float
-  // alone loses digits over 300k points, double alone halves the throughput. The order is
-  // fixed, so the bytes are too.
+  // alone loses digits over 300k points, double alone halves the throughput. The blocks are
+  // added in order, so the bytes are fixed.
   using P4 = Eigen::Array<float, 4, 1>;
-  double lo_sum[4][4] = {}, hi_sum[7][4] = {};
+  struct BlockSums {
+    P4 lo[4], hi[7];
+  };
   const float nu = static_cast<float>(options_.t_dof);
   const float inv = options_.robust ? static_cast<float>(1.0 / sigma2) : 0.0f;
   const bool robust = options_.robust;
   const std::size_t n_points = level.size();
   constexpr std::size_t kBlock = 256;
-  for (std::size_t begin = 0; begin < n_points; begin += kBlock) {
+  std::vector<BlockSums> blocks((n_points + kBlock - 1) / kBlock);
+  for_each_block(n_points, kBlock, [&](std::size_t k, std::size_t begin, std::size_t end) {
     P4 lo[4], hi[7];
     for (P4& x : lo) x.setZero();
     for (P4& x : hi) x.setZero();
-    const std::size_t end = std::min(n_points, begin + kBlock);
     for (std::size_t i = begin; i < end; ++i) {
       const float r = residuals[i];
       if (std::isnan(r)) continue;
@@ -345,10 +400,15 @@ void Aligner::normal_equations(const RefLevel& level, const std::vector<float>& 
       }
       for (int c = 0; c < 3; ++c) hi[4 + c] += wb * b[c];
     }
+    for (int c = 0; c < 4; ++c) blocks[k].lo[c] = lo[c];
+    for (int c = 0; c < 7; ++c) blocks[k].hi[c] = hi[c];
+  });
+  double lo_sum[4][4] = {}, hi_sum[7][4] = {};
+  for (const BlockSums& block : blocks) {
     for (int c = 0; c < 4; ++c)
-      for (int k = 0; k < 4; ++k) lo_sum[c][k] += lo[c][k];
+      for (int k = 0; k < 4; ++k) lo_sum[c][k] += block.lo[c][k];
     for (int c = 0; c < 7; ++c)
-      for (int k = 0; k < 4; ++k) hi_sum[c][k] += hi[c][k];
+      for (int k = 0; k < 4; ++k) hi_sum[c][k] += block.hi[c][k];
   }
   for (int a = 0; a < 4; ++a)
     for (int c = 0; c < 4; ++c) n->H[a][c] = lo_sum[c][a];

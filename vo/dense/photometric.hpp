@@ -95,6 +95,22 @@ struct RefLevel {
     textured.clear();
   }
   std::size_t size() const { return points.size(); }
+  void append(const RefLevel& more) {
+    points.insert(points.end(), more.points.begin(), more.points.end());
+    jacobians.insert(jacobians.end(), more.jacobians.begin(), more.jacobians.end());
+    textured.insert(textured.end(), more.textured.begin(), more.textured.end());
+  }
+};
+
+/// What a piece of rows of a level selects (build_reference's scratch): its points and, at full
+/// resolution, its textured pixels and those of them with depth.
+struct RowsSelected {
+  RefLevel level;
+  int textured = 0, both = 0;
+  void clear() {
+    level.clear();
+    textured = both = 0;
+  }
 };
 
 /// What selects reference pixels.
@@ -113,6 +129,7 @@ struct Reference {
   int textured_depth_pixels = 0;  ///< of those, with a valid depth
   cv::Mat textured;               ///< scratch: full-resolution texture mask, CV_8UC1 0/1
   std::vector<int> col_first, col_last, row_first, row_last;  ///< scratch: coarse pixel blocks
+  std::vector<RowsSelected> pieces;                           ///< scratch: pieces of rows
 };
 
 /// Builds the reference of a frame from its pyramid and its full-resolution disparity
