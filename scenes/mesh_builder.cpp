@@ -140,13 +140,7 @@ void append_mesh(sim::Mesh* dst, const sim::Mesh& src, const Vec3& offset) {
     dst->vertices.push_back(v);
   }
   for (std::uint32_t i : src.indices) dst->indices.push_back(base + i);
-  if (!src.sway.empty() || !dst->sway.empty()) {
-    dst->sway.resize(base, {0.f, 0.f});
-    if (src.sway.empty())
-      dst->sway.resize(dst->vertices.size(), {0.f, 0.f});
-    else
-      dst->sway.insert(dst->sway.end(), src.sway.begin(), src.sway.end());
-  }
+  sim::append_sway(dst, base, src);
 }
 
 void add_mesh(sim::SceneGeometry* scene, sim::Mesh mesh) {

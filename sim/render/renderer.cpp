@@ -449,13 +449,7 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     const auto base = static_cast<std::uint32_t>(d.vertices.size());
     d.vertices.insert(d.vertices.end(), x.vertices.begin(), x.vertices.end());
     for (std::uint32_t i : x.indices) d.indices.push_back(base + i);
-    if (!x.sway.empty() || !d.sway.empty()) {  // a rigid mesh's vertices weigh 0
-      d.sway.resize(base, {0.f, 0.f});
-      if (x.sway.empty())
-        d.sway.resize(d.vertices.size(), {0.f, 0.f});
-      else
-        d.sway.insert(d.sway.end(), x.sway.begin(), x.sway.end());
-    }
+    append_sway(&d, base, x);
   }
   for (const Mesh& mesh : merged) {
     if (mesh.material.texture >= static_cast<int>(scene.textures.size()))

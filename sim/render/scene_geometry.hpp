@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <numbers>
 #include <string>
@@ -104,6 +105,18 @@ struct Mesh {
   // flutters (1 for a leaf card). StereoRenderer::set_sway says how the wind moves them.
   std::vector<std::array<float, 2>> sway;
 };
+
+/// The sway weights of `dst` after src's vertices were appended to it from index `base` on
+/// (mesh merging): a rigid mesh's vertices weigh 0, and the merge stays rigid (no weights) while
+/// both parts are.
+inline void append_sway(Mesh* dst, std::size_t base, const Mesh& src) {
+  if (src.sway.empty() && dst->sway.empty()) return;
+  dst->sway.resize(base, {0.f, 0.f});
+  if (src.sway.empty())
+    dst->sway.resize(dst->vertices.size(), {0.f, 0.f});
+  else
+    dst->sway.insert(dst->sway.end(), src.sway.begin(), src.sway.end());
+}
 
 /// Light and sky.
 struct Lighting {
