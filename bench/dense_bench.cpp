@@ -15,9 +15,10 @@
 //                        sgbm_ms (SGBM + disparity refinement), alignment_ms (pyramid +
 //                        reference points and Jacobians + Levenberg-Marquardt), and their parts
 //   BM_DenseVoPaper      the same, river paper's plain method
-//   BM_DenseVo1024/threads:N/3way:M
+//   BM_DenseVo1024/threads:N/sgbm:M
 //                        BM_DenseVo through the river scenarios' Bumblebee2 (1024x768) with N
-//                        threads in OpenCV's pool, M = 1: sgbm_mode 3way; one_core_ms adds the
+//                        threads in OpenCV's pool, M = 1: sgbm_mode sgbm (the default before
+//                        3way, 2026-12-02); one_core_ms adds the
 //                        stages (the wall overlaps two of them: with N = 1 it is the work of a
 //                        frame on one core)
 //   BM_Sgbm              cv::StereoSGBM alone on the full pair (the paper's method)
@@ -151,15 +152,15 @@ void BM_DenseVoPaper(benchmark::State& state) { run_vo(state, DenseVoOptions::pa
 BENCHMARK(BM_DenseVoPaper)->Unit(benchmark::kMillisecond);
 
 // The whole VO at the Bumblebee2's 1024x768, as in the river scenarios, with OpenCV's pool (the
-// VO's loops run on it) at 1 to 16 threads; the defaults, and with sgbm_mode 3way.
+// VO's loops run on it) at 1 to 16 threads; the defaults, and with sgbm_mode sgbm.
 void BM_DenseVo1024(benchmark::State& state) {
   DenseVoOptions o;
-  if (state.range(1) == 1) o.sgbm_mode = DenseSgbmMode::kThreeWay;
+  if (state.range(1) == 1) o.sgbm_mode = DenseSgbmMode::kSgbm;
   run_vo(state, o, sequence_1024(), static_cast<int>(state.range(0)));
 }
 BENCHMARK(BM_DenseVo1024)
     ->ArgsProduct({{1, 2, 4, 8, 16}, {0, 1}})
-    ->ArgNames({"threads", "3way"})
+    ->ArgNames({"threads", "sgbm"})
     ->Unit(benchmark::kMillisecond);
 
 void run_disparity(benchmark::State& state, const dense::DisparityOptions& options) {
