@@ -148,9 +148,9 @@ struct StereoRenderer::Impl {
   std::unique_ptr<GlContext> context;
   std::unique_ptr<MipChain> mip_chain;  // the mirror image's blur levels under wind ripples
   // Programs by variant: [mode][sun][cutout] with mode 0 gray, 1 linear depth.
-  GLuint scene_progs[2][2][2] = {};
-  GLuint water_progs[2][2][2] = {};  // [mode][sun][ripples]
-  GLuint sky_progs[2][2] = {};       // [sun][clouds]
+  GLuint scene_progs[2][2][2][2] = {};  // [mode][sun][cutout][sway]
+  GLuint water_progs[2][2][2] = {};     // [mode][sun][ripples]
+  GLuint sky_progs[2][2] = {};          // [sun][clouds]
   GLuint empty_vao = 0;
   std::vector<GpuMesh> meshes;
   std::vector<GLuint> textures;
@@ -249,9 +249,10 @@ StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& option
       const std::string defines =
           fmt::format("#define DEPTH {}\n#define SUN {}\n", mode, sun) + colour;
       for (int cutout : {0, 1})
-        impl_->scene_progs[mode][sun][cutout] =
-            link_program(shaders::kSceneVs, shaders::kSceneFs, "scene",
-                         defines + fmt::format("#define CUTOUT {}\n", cutout));
+        for (int sway : {0, 1})
+          impl_->scene_progs[mode][sun][cutout][sway] = link_program(
+              shaders::kSceneVs, shaders::kSceneFs, "scene",
+              defines + fmt::format("#define CUTOUT {}\n#define SWAY {}\n", cutout, sway));
       for (int ripples : {0, 1})
         impl_->water_progs[mode][sun][ripples] =
             link_program(shaders::kWaterVs, shaders::kWaterFs, "water",
@@ -654,14 +655,22 @@ void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::
   // Opaque meshes first, then the alpha-tested ones (each group nearest first): a discarding
   // shader tests depth early but writes it late on llvmpipe, so cards drawn last meet a depth
   // buffer that already rejects what opaque surfaces hide.
+  // A mesh that cannot sway (no weights, or no wind) is drawn by the variant without the sway's
+  // vertex branch, in the same order: the branch leaves its vertices where they are.
   for (int cutout : {0, 1}) {
-    const GLuint prog = scene_progs[mode][sun_variant][cutout];
-    bool bound = false;
+    std::array<bool, 2> ready = {};  // the pass's uniforms set on each variant's program
+    GLuint bound = 0;
     for (const auto& [distance, index] : draw_order) {
       const GpuMesh& g = meshes[index];
       if (g.cutout != (cutout == 1)) continue;
-      if (!bound) set_pass_uniforms(prog);
-      bound = true;
+      const int sways = !sway.empty() && g.sway_vbo != 0 ? 1 : 0;
+      const GLuint prog = scene_progs[mode][sun_variant][cutout][sways];
+      if (!ready[static_cast<std::size_t>(sways)])
+        set_pass_uniforms(prog);
+      else if (prog != bound)
+        glUseProgram(prog);
+      ready[static_cast<std::size_t>(sways)] = true;
+      bound = prog;
       draw_mesh(prog, g);
     }
   }

@@ -9,8 +9,9 @@ namespace driftlab::sim::shaders {
 // gray), SUN (sun glints, which need per-pixel normals and view vectors), COLOUR (RGB
 // images: the scene's materials tinted by their colour, water and sky gray), for the scene
 // CUTOUT (an alpha-tested texture, grey in r and alpha in g: fragments under 0.5 are discarded in
-// every pass, so the depth and mirror images show the same holes) and, for the sky, CLOUDS (the
-// cloud deck's texture).
+// every pass, so the depth and mirror images show the same holes) and SWAY (the wind moves the
+// vertices with sway weights; 0 for rigid meshes and still scenes, whose vertices the branch
+// leaves where they are) and, for the sky, CLOUDS (the cloud deck's texture).
 // On llvmpipe the cost of a fragment is mostly the interpolation of its
 // inputs, so each variant carries only what it reads: lighting and fog are
 // smooth over a triangle and are evaluated per vertex (Gouraud).
@@ -18,7 +19,9 @@ inline constexpr const char* kSceneVs = R"(
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
+#if SWAY
 layout(location = 3) in vec2 a_sway;  // Mesh::sway: sway and flutter weights ((0, 0): rigid)
+#endif
 uniform mat4 u_view;       // world -> camera (optical)
 uniform mat4 u_proj;
 uniform mat4 u_model;      // mesh -> world: the identity, or the body's pose for a body mesh
@@ -53,6 +56,7 @@ out vec3 v_normal;
 void main() {
   vec3 w = (u_model * vec4(a_pos, 1.0)).xyz;
   float moving = u_moving;
+#if SWAY
   if (u_sway_n > 0 && a_sway != vec2(0.0)) {
     float s = dot(u_wind_dir, w.xy), g = 0.0;
     for (int k = 0; k < u_sway_n; ++k) g += u_sway[k].x * sin(u_sway[k].z - u_sway[k].y * s);
@@ -60,6 +64,7 @@ void main() {
     w += vec3(u_wind_dir * (a_sway.x * g + a_sway.y * f), 0.5 * a_sway.y * f);
     if (dot(a_sway, u_sway_reach) > 0.001) moving = 1.0;  // it moves by a millimetre or more
   }
+#endif
   vec3 p = vec3(w.xy, w.z * u_mirror);
   vec4 c = u_view * vec4(p, 1.0);
 #if DEPTH
