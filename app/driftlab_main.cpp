@@ -247,12 +247,17 @@ struct RenderVerb : Pinned {
                   "where a moving vessel is seen, 0 elsewhere)");
     cmd->add_option("--set", sets, "Override a key: KEY.PATH=VALUE (repeatable)");
     cmd->add_flag("--force", force, "Replace an existing output folder");
+    cmd->add_flag("--profile", profile,
+                  "Time each of the renderer's passes (mirror images, their blur levels, the "
+                  "ripples' maps, water, scene, sky, read-back, truth; glFinish after each, so "
+                  "slower, the same images) and print where a frame's time went");
   }
 
   std::optional<int> dispatch() const {
     if (!cmd->parsed()) return std::nullopt;
     const auto scenario = driftlab::pipeline::load_scenario(file, sets);
     driftlab::pipeline::RenderSequenceOptions ro;
+    ro.profile = profile;
     ro.max_frames = frames;
     ro.depth = depth;
     ro.masks = masks;
@@ -269,6 +274,7 @@ struct RenderVerb : Pinned {
   bool masks = false;
   std::vector<std::string> sets;
   bool force = false;
+  bool profile = false;
 };
 
 struct EvalVerb : Pinned {

@@ -38,10 +38,19 @@ void write_pfm(const std::filesystem::path& path, const sim::DepthImage& d) {
 }  // namespace
 
 std::string RenderSequenceSummary::brief() const {
-  return fmt::format(
+  std::string out = fmt::format(
       "rendered {} stereo pairs ({} triangles) at {:.1f} pairs/s; scene built in "
       "{:.2f} s; {}",
       frames, triangles, pairs_per_s, scene_build_s, context);
+  if (passes && frames > 0) {
+    const double frame_ms = 1e3 * render_s / static_cast<double>(frames);
+    out += fmt::format(
+        "\nprofile: {:.1f} ms a frame, of which the renderer's passes {:.1f} ms and the camera "
+        "stage's own work (exposure, blur, lens, noise) and the rest {:.1f} ms; the passes:\n{}",
+        frame_ms, passes->total_ms() / static_cast<double>(frames),
+        frame_ms - passes->total_ms() / static_cast<double>(frames), describe_passes(*passes));
+  }
+  return out;
 }
 
 void set_water_surface(sim::StereoRenderer* renderer, const Scenario& sc) {
@@ -106,6 +115,7 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
   sim::StereoRenderer renderer(rig_of(sc.sensors.camera), sc.render);
   renderer.upload(scene);
   set_water_surface(&renderer, sc);
+  renderer.set_profiling(options.profile);
   summary.triangles = renderer.triangles();
   summary.context = renderer.context_description();
 
@@ -149,6 +159,7 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
   summary.frames = delivered;
   summary.render_s = render_s;
   summary.pairs_per_s = render_s > 0 ? static_cast<double>(delivered) / render_s : 0;
+  if (options.profile) summary.passes = renderer.pass_times();
   return summary;
 }
 

@@ -3,10 +3,12 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "core/camera.hpp"
 #include "pipeline/scenario.hpp"
+#include "sim/render/renderer.hpp"
 #include "sim/render/scene_geometry.hpp"
 
 namespace driftlab::sim {
@@ -20,6 +22,7 @@ struct RenderSequenceOptions {
   bool depth = false;  // also write depth/NNNNNN.pfm (metres, float)
   bool masks = false;  // also write mask/NNNNNN.png (255: a moving thing; sim::TruthImages)
   bool replace_existing = false;
+  bool profile = false;  // time the renderer's passes (sim::StereoRenderer::set_profiling)
 };
 
 struct RenderSequenceSummary {
@@ -28,7 +31,8 @@ struct RenderSequenceSummary {
   double scene_build_s = 0;
   double render_s = 0;  // rendering and read-back only
   double pairs_per_s = 0;
-  std::string context;  // GL version and renderer
+  std::string context;                         // GL version and renderer
+  std::optional<sim::RenderPassTimes> passes;  // with RenderSequenceOptions::profile
   std::string brief() const;
 };
 

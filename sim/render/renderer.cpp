@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "core/stopwatch.hpp"
 #include "sim/render/alpha_mips.hpp"
 #include "sim/render/gl_program.hpp"
 #include "sim/render/mip_chain.hpp"
@@ -145,9 +146,16 @@ struct StereoRenderer::Impl {
   float sway_reach_m = 0;  // the most a unit-weight vertex moves (sway and flutter)
   // The sway's uniforms at time t (phases reduced modulo 2 pi in double precision).
   void set_sway_uniforms(GLuint prog, double t) const;
+  // Profiling (set_profiling): lap_start marks the time after glFinish; lap(slot) finishes the
+  // pass drawn since, adds its time to times.*slot and marks again. Both do nothing otherwise.
+  bool profiling = false;
+  RenderPassTimes times;
+  SteadyClock::time_point lap_mark;
+  void lap_start();
+  void lap(double RenderPassTimes::*slot);
   std::unique_ptr<GlContext> context;
   std::unique_ptr<MipChain> mip_chain;  // the mirror image's blur levels under wind ripples
-  // Programs by variant: [mode][sun][cutout] with mode 0 gray, 1 linear depth.
+  // Programs by variant, mode 0 gray, 1 linear depth.
   GLuint scene_progs[2][2][2][2] = {};  // [mode][sun][cutout][sway]
   GLuint water_progs[2][2][2] = {};     // [mode][sun][ripples]
   GLuint sky_progs[2][2] = {};          // [sun][clouds]
@@ -726,7 +734,9 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   const Eigen::Vector3f sun = L.sun_direction_W.normalized();
   glUniform3f(loc(water_prog, "u_sun_dir"), sun.x(), sun.y(), sun.z());
   if (ripples && mode == 0) {
+    lap(&RenderPassTimes::water_ms);  // what was drawn before (the clear)
     upload_ripples(t);
+    lap(&RenderPassTimes::ripples_ms);
     // Texture coordinates relative to the eye, the eye's own reduced in double.
     for (int tile = 0; tile < RippleMaps::kTiles; ++tile) {
       const double L = ripples->tile_size_m(tile);
@@ -881,7 +891,11 @@ void StereoRenderer::Impl::draw_reflection(const SE3& T_W_C, double t, int eye_i
     glBlitFramebuffer(0, 0, RW, RH, 0, 0, RW, RH, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
   if (scissored) glDisable(GL_SCISSOR_TEST);
-  if (ripples) mip_chain->build(e.refl_tex, RW, RH, refl_levels);
+  lap(&RenderPassTimes::mirror_ms);
+  if (ripples) {
+    mip_chain->build(e.refl_tex, RW, RH, refl_levels);
+    lap(&RenderPassTimes::mirror_mips_ms);
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
@@ -914,8 +928,11 @@ void StereoRenderer::Impl::draw_eye_rows(const SE3& T_W_C, double t, int eye_ind
   // then the scene nearest first, then the sky on the far plane where nothing
   // was drawn: every pixel is shaded about once.
   draw_water(view, eye, t, 0, reflects() ? e.refl_tex : 0);
+  lap(&RenderPassTimes::water_ms);
   draw_scene(view, eye, 1.f, 0, t);
+  lap(&RenderPassTimes::scene_ms);
   draw_sky(view, 1.f);
+  lap(&RenderPassTimes::sky_ms);
   if (band) glDisable(GL_SCISSOR_TEST);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
@@ -948,6 +965,7 @@ GrayImage StereoRenderer::Impl::read_eye(int eye_index) {
   img.height = H;
   img.pixels.resize(static_cast<std::size_t>(W) * H);
   glReadPixels(0, 0, W, H, GL_RED, GL_UNSIGNED_BYTE, img.pixels.data());
+  lap(&RenderPassTimes::readback_ms);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return img;
 }
@@ -967,6 +985,7 @@ TruthImages StereoRenderer::Impl::render_truth(const SE3& T_W_C, double t) {
   const std::size_t n = static_cast<std::size_t>(W) * H;
   std::vector<float> rg(2 * n);
   glReadPixels(0, 0, W, H, GL_RG, GL_FLOAT, rg.data());
+  lap(&RenderPassTimes::truth_ms);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   TruthImages out;
   out.depth.width = out.moving.width = W;
@@ -982,7 +1001,58 @@ TruthImages StereoRenderer::Impl::render_truth(const SE3& T_W_C, double t) {
 
 TruthImages StereoRenderer::render_truth(const SE3& T_W_C, double t_s) {
   impl_->context->make_current();
+  impl_->lap_start();
+  ++impl_->times.truths;
   return impl_->render_truth(T_W_C, t_s);
+}
+
+void StereoRenderer::Impl::lap_start() {
+  if (!profiling) return;
+  glFinish();
+  lap_mark = SteadyClock::now();
+}
+
+void StereoRenderer::Impl::lap(double RenderPassTimes::*slot) {
+  if (!profiling) return;
+  glFinish();
+  const auto now = SteadyClock::now();
+  times.*slot += std::chrono::duration<double, std::milli>(now - lap_mark).count();
+  lap_mark = now;
+}
+
+void StereoRenderer::set_profiling(bool on) {
+  impl_->profiling = on;
+  impl_->times = {};
+}
+
+const RenderPassTimes& StereoRenderer::pass_times() const { return impl_->times; }
+
+double RenderPassTimes::total_ms() const {
+  return mirror_ms + mirror_mips_ms + ripples_ms + water_ms + scene_ms + sky_ms + readback_ms +
+         truth_ms;
+}
+
+std::string describe_passes(const RenderPassTimes& t) {
+  const double total = t.total_ms();
+  const auto share = [&](double ms) { return total > 0 ? 100.0 * ms / total : 0.0; };
+  const double pairs = std::max(t.renders, 1), truths = std::max(t.truths, 1);
+  std::string out = fmt::format(
+      "{} stereo pairs, {} truth passes; ms a pair (glFinish after each "
+      "pass), share of the renderer's time:\n",
+      t.renders, t.truths);
+  const std::pair<const char*, double> rows[] = {
+      {"mirror images (scene and sky mirrored)", t.mirror_ms},
+      {"mirror blur levels", t.mirror_mips_ms},
+      {"ripple slope maps (bake and upload)", t.ripples_ms},
+      {"water", t.water_ms},
+      {"scene meshes", t.scene_ms},
+      {"sky", t.sky_ms},
+      {"resolve and read back", t.readback_ms}};
+  for (const auto& [name, ms] : rows)
+    out += fmt::format("  {:<40} {:8.2f} ms {:5.1f} %\n", name, ms / pairs, share(ms));
+  out += fmt::format("  {:<40} {:8.2f} ms {:5.1f} % (ms a truth pass)\n",
+                     "truth: depth and moving mask", t.truth_ms / truths, share(t.truth_ms));
+  return out;
 }
 
 bool StereoRenderer::has_moving_things() const {
@@ -1000,6 +1070,8 @@ ColourImage StereoRenderer::render_colour(const SE3& T_W_C, double t_s) {
   Impl& m = *impl_;
   DRIFTLAB_DEMAND_MSG(m.colour, "render_colour: the renderer draws gray images");
   m.context->make_current();
+  m.lap_start();
+  ++m.times.renders;  // one eye's image
   if (m.reflects()) m.draw_reflection(T_W_C, t_s, 0);
   m.draw_eye(T_W_C, t_s, 0);
   const Impl::EyeTargets& e = m.eyes[0];
@@ -1023,6 +1095,9 @@ void StereoRenderer::set_right_camera(const SE3& T_left_right) {
 
 StereoImages StereoRenderer::render(const SE3& T_W_C_left, double t_s, bool with_depth) {
   impl_->context->make_current();
+  impl_->lap_start();
+  ++impl_->times.renders;
+  if (with_depth) ++impl_->times.truths;
   StereoImages out;
   const SE3 T_W_C_right = T_W_C_left * impl_->T_left_right;
   // Both mirror images first: an eye's image samples its own, and llvmpipe makes this thread
@@ -1057,6 +1132,8 @@ StereoImages StereoRenderer::render_bands(const std::vector<RowBand>& left,
       left[0].T_W_C.matrix() == right[0].T_W_C.matrix())
     return render(left[0].T_W_C, left[0].t_s, false);
   m.context->make_current();
+  m.lap_start();
+  ++m.times.renders;
   // Band by band: each band's mirror image from its own pose, then its rows.
   for (int eye = 0; eye < 2; ++eye) {
     m.clear_eye(eye);

@@ -81,6 +81,26 @@ struct ColourImage {
 /// Material::colour; water, sky and the mirror image stay gray).
 enum class ImageKind { kGray, kColour };
 
+/// Where a renderer's time goes (StereoRenderer::set_profiling): the wall time of each pass,
+/// summed over every call since profiling began, with glFinish after each pass, so that the
+/// passes do not overlap as they do unprofiled (their sum exceeds an unprofiled frame's time).
+/// describe_passes turns it into text.
+struct RenderPassTimes {
+  int renders = 0;            ///< render() and render_bands() calls (stereo pairs drawn)
+  int truths = 0;             ///< render_truth() calls
+  double mirror_ms = 0;       ///< the mirror images: the scene and the sky mirrored
+  double mirror_mips_ms = 0;  ///< their blur levels (only under wind ripples)
+  double ripples_ms = 0;      ///< the ripples' slope maps: baked and uploaded once a time step
+  double water_ms = 0;        ///< the water surface, sampling the mirror image
+  double scene_ms = 0;        ///< the scene's meshes (banks, trees, buildings, vessels)
+  double sky_ms = 0;          ///< the sky where nothing else was drawn
+  double readback_ms = 0;     ///< both eyes resolved and read back to the CPU
+  double truth_ms = 0;        ///< render_truth: depth and the moving mask, read back
+  double total_ms() const;
+};
+/// One line a pass: its mean milliseconds a stereo pair (truth: a call) and its share.
+std::string describe_passes(const RenderPassTimes& t);
+
 /// Largest number of wave components the water shader sums (the strongest are kept).
 constexpr int kMaxShaderWaveComponents = 32;
 
@@ -130,6 +150,10 @@ class StereoRenderer {
   ColourImage render_colour(const SE3& T_W_C, double t_s);
   const std::string& context_description() const;
   std::size_t triangles() const;
+  /// Times each pass from now on (glFinish after each: slower, the same images) into
+  /// pass_times(), reset here; false stops.
+  void set_profiling(bool on);
+  const RenderPassTimes& pass_times() const;
 
  private:
   struct Impl;

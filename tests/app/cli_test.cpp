@@ -360,6 +360,26 @@ TEST(CliRender, OneFrameIsOneFrame) {
   fs::remove_all(dir);
 }
 
+TEST(CliRender, ProfileSaysWhereEachFramesTimeWent) {
+  // --profile: the frame's time, the passes' part of it and one line a pass (the crossing has
+  // nothing that moves: no truth pass); the same images.
+  const fs::path dir = fresh_temp_dir("profile");
+  const std::string scenario = (kSource / "scenarios/river_crossing.yaml").string();
+  const Result r =
+      run_cli({"render", scenario, "--frames", "2", "--profile", "--out", (dir / "p").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* line : {"profile: ", "2 stereo pairs, 0 truth passes", "mirror images", "water",
+                           "scene meshes", "sky", "resolve and read back", "truth: "})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+  const Result plain =
+      run_cli({"render", scenario, "--frames", "2", "--out", (dir / "q").string()});
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_EQ(plain.out.find("profile: "), std::string::npos) << plain.out;
+  for (const char* f : {"left/000000.png", "left/000001.png", "right/000001.png"})
+    EXPECT_EQ(slurp(dir / "p" / f), slurp(dir / "q" / f)) << f;
+  fs::remove_all(dir);
+}
+
 TEST(CliEval, ReadsARunsFramesCsvAsTheColumnsOfTheEstimatesVo) {
   // A run's frames.csv with two VOs' blocks; the estimate file's name says whose f to read.
   const fs::path dir = fresh_temp_dir("eval_frames");

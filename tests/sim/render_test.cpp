@@ -452,6 +452,45 @@ TEST(Render, MipLevelsOfTheMirrorImageAreTwoByTwoMeans) {
   }
 }
 
+TEST(Render, ProfilingTimesEachPassDrawnAndLeavesTheImagesAsTheyAre) {
+  // The same frames with and without the passes timed (glFinish after each), calm and rippled;
+  // a pass that is drawn takes time, one that is not (the blur levels and the ripples' maps on
+  // calm water) none, and the passes add up to the total.
+  StereoRenderer r(rig_640(), RenderOptions{});
+  r.upload(checker_disc_over_water(Vec3(8, 0, -1.5), 1.2, 30, 220));
+  const SE3 T_W_C = camera_at(Vec3(0, 0, -0.5));
+  WindOptions w;
+  w.speed_mps = 3.0;
+  for (const bool rippled : {false, true}) {
+    r.set_ripples(rippled ? std::make_shared<RippleMaps>(w, CurrentOptions{},
+                                                         RngStreams(3).stream("water.ripples"))
+                          : nullptr);
+    r.set_profiling(false);
+    const StereoImages plain = r.render(T_W_C, 2.0, false);
+    const TruthImages plain_truth = r.render_truth(T_W_C, 2.0);
+    r.set_profiling(true);
+    const StereoImages timed = r.render(T_W_C, 2.0, false);
+    const TruthImages timed_truth = r.render_truth(T_W_C, 2.0);
+    EXPECT_EQ(plain.left.pixels, timed.left.pixels) << rippled;
+    EXPECT_EQ(plain.right.pixels, timed.right.pixels) << rippled;
+    EXPECT_EQ(plain_truth.depth.depth_m, timed_truth.depth.depth_m) << rippled;
+    const RenderPassTimes& t = r.pass_times();
+    EXPECT_EQ(t.renders, 1);
+    EXPECT_EQ(t.truths, 1);
+    for (const double ms :
+         {t.mirror_ms, t.water_ms, t.scene_ms, t.sky_ms, t.readback_ms, t.truth_ms})
+      EXPECT_GT(ms, 0.0) << rippled;
+    EXPECT_EQ(t.mirror_mips_ms > 0.0, rippled);
+    EXPECT_EQ(t.ripples_ms > 0.0, rippled);
+    EXPECT_DOUBLE_EQ(t.total_ms(), t.mirror_ms + t.mirror_mips_ms + t.ripples_ms + t.water_ms +
+                                       t.scene_ms + t.sky_ms + t.readback_ms + t.truth_ms);
+    const std::string text = describe_passes(t);
+    EXPECT_NE(text.find("mirror blur levels"), std::string::npos) << text;
+    r.set_profiling(false);
+    EXPECT_EQ(r.pass_times().renders, 0);
+  }
+}
+
 // A rolling-shutter image, band by band, against its second method: each band's rows cut out of
 // a whole frame rendered at that band's pose and time. The bands draw only the rows of their
 // mirror images that their rows read (StereoRenderer::Impl::reflection_rows), so steep waves,
