@@ -225,6 +225,39 @@ void dilate_grey(const std::vector<std::uint8_t>& alpha, int size, std::vector<s
   }
 }
 
+// The texture of a painted canvas: alpha from the subsamples, each texel's grey the mean of its
+// inside subsamples scaled so that the opaque texels' mean is mean_grey, transparent texels
+// dilated.
+sim::Texture finish_texture(const Canvas& c, const char* name, double mean_grey) {
+  const int size_px = c.size;
+  const long texels = static_cast<long>(size_px) * size_px;
+  sim::Texture t;
+  t.name = name;
+  t.width = t.height = size_px;
+  t.pixels.assign(texels, 0);
+  t.alpha.assign(texels, 0);
+  // Texel grey: the mean of its inside subsamples; scaled so the opaque texels' mean is mean_grey.
+  std::vector<double> g(texels, 0.0);
+  double sum_opaque = 0;
+  for (long i = 0; i < texels; ++i) {
+    t.alpha[i] = alpha_of(c.count[i]);
+    if (c.count[i] == 0) continue;
+    const long x = i % size_px, y = i / size_px;
+    for (int sy = 0; sy < kSub; ++sy)
+      for (int sx = 0; sx < kSub; ++sx) {
+        const std::size_t s = static_cast<std::size_t>(y * kSub + sy) * c.n + x * kSub + sx;
+        if (c.inside[s]) g[i] += c.grey[s];
+      }
+    g[i] /= c.count[i];
+    if (t.alpha[i] >= sim::kAlphaOpaqueFrom) sum_opaque += g[i];
+  }
+  const double gain_grey = mean_grey / (sum_opaque / static_cast<double>(c.opaque));
+  for (long i = 0; i < texels; ++i)
+    t.pixels[i] = static_cast<std::uint8_t>(std::clamp(std::lround(g[i] * gain_grey), 0L, 255L));
+  dilate_grey(t.alpha, size_px, &t.pixels);
+  return t;
+}
+
 }  // namespace
 
 double leaf_target_coverage(LeafShape shape) { return shape == LeafShape::kBroad ? 0.60 : 0.50; }
@@ -257,31 +290,41 @@ sim::Texture make_leaf_cluster(LeafShape shape, Rng* rng, double mean_grey, doub
     paint(&c, best.petiole);
     paint(&c, best.leaf);
   }
-  sim::Texture t;
-  t.name = shape == LeafShape::kBroad ? "leaves_broad" : "leaves_narrow";
-  t.width = t.height = size_px;
-  t.pixels.assign(texels, 0);
-  t.alpha.assign(texels, 0);
-  // Texel grey: the mean of its inside subsamples; scaled so the opaque texels' mean is mean_grey.
-  std::vector<double> g(texels, 0.0);
-  double sum_opaque = 0;
-  for (long i = 0; i < texels; ++i) {
-    t.alpha[i] = alpha_of(c.count[i]);
-    if (c.count[i] == 0) continue;
-    const long x = i % size_px, y = i / size_px;
-    for (int sy = 0; sy < kSub; ++sy)
-      for (int sx = 0; sx < kSub; ++sx) {
-        const std::size_t s = static_cast<std::size_t>(y * kSub + sy) * c.n + x * kSub + sx;
-        if (c.inside[s]) g[i] += c.grey[s];
-      }
-    g[i] /= c.count[i];
-    if (t.alpha[i] >= sim::kAlphaOpaqueFrom) sum_opaque += g[i];
+  return finish_texture(c, shape == LeafShape::kBroad ? "leaves_broad" : "leaves_narrow",
+                        mean_grey);
+}
+
+double reed_target_coverage() { return 0.30; }
+
+sim::Texture make_reed_clump(Rng* rng, double mean_grey, double contrast, int size_px) {
+  DRIFTLAB_DEMAND_MSG(size_px >= 64 && size_px <= 4096, "reed clump size must be 64-4096 px");
+  DRIFTLAB_DEMAND_MSG(mean_grey >= 0 && mean_grey <= 255 && contrast >= 0,
+                      "reed clump needs mean_grey in [0, 255] and contrast >= 0");
+  const double size = size_px, scale = size_px / 256.0;
+  Canvas c(size_px);
+  const long target =
+      static_cast<long>(std::ceil(reed_target_coverage() * static_cast<double>(size_px) * size_px));
+  // Blades from a narrow foot at the bottom edge, fanning out up to 28 deg from the vertical,
+  // widest at the foot and tapering to a point (Shape's lanceolate profile with its widest
+  // point at the foot), until the opaque share reaches the target.
+  for (int iter = 0; c.opaque < target; ++iter) {
+    DRIFTLAB_DEMAND_MSG(iter < 100000, "reed clump did not reach its coverage");
+    Shape blade;
+    blade.leaf = true;
+    blade.kind = LeafShape::kNarrow;
+    blade.widest = 0;
+    blade.a = Vec2(size * rng->uniform(0.3, 0.7), size * 0.985);
+    const double lean = rng->uniform(-28, 28) * kDeg;
+    blade.dir = Vec2(std::sin(lean), -std::cos(lean));
+    blade.length = size * rng->uniform(0.45, 0.95);
+    blade.width = scale * rng->uniform(5, 9);
+    blade.grey = std::max(0.2, 1 + contrast * rng->normal());
+    const Vec2 tip = blade.a + blade.length * blade.dir;
+    blade.lo = blade.a.cwiseMin(tip).array() - 0.5 * blade.width;
+    blade.hi = blade.a.cwiseMax(tip).array() + 0.5 * blade.width;
+    paint(&c, blade);
   }
-  const double gain_grey = mean_grey / (sum_opaque / static_cast<double>(c.opaque));
-  for (long i = 0; i < texels; ++i)
-    t.pixels[i] = static_cast<std::uint8_t>(std::clamp(std::lround(g[i] * gain_grey), 0L, 255L));
-  dilate_grey(t.alpha, size_px, &t.pixels);
-  return t;
+  return finish_texture(c, "reeds_clump", mean_grey);
 }
 
 }  // namespace driftlab::scenes

@@ -32,4 +32,15 @@ double leaf_target_coverage(LeafShape shape);
 sim::Texture make_leaf_cluster(LeafShape shape, Rng* rng, double mean_grey, double contrast,
                                int size_px = 256);
 
+/// The share of opaque texels a reed clump is drawn to: 0.30 (make_reed_clump ends within
+/// [target, target + 0.03]).
+double reed_target_coverage();
+
+/// A square reed-clump card texture with alpha, for reed_model: cards: blades from a narrow foot
+/// at the bottom edge (the middle 40 %), fanning out up to 28 deg from the vertical, 45-95 % of
+/// the texture tall and 5-9 px wide at the foot (at 256 px), tapering to a point, each blade's
+/// grey varied and its midrib darker, added until reed_target_coverage(). Alpha, border and
+/// dilation as make_leaf_cluster's. Deterministic in `rng`. Named "reeds_clump".
+sim::Texture make_reed_clump(Rng* rng, double mean_grey, double contrast, int size_px = 256);
+
 }  // namespace driftlab::scenes

@@ -115,6 +115,7 @@ sim::Material solid(int texture, float albedo) {
 struct Textures {
   int grass, soil, bark, foliage, reeds, concrete, sheet, facade, roof, brick, stone;
   int leaves_broad, leaves_narrow;  // leaf-cluster cards (alpha), at the foliage's mean grey
+  int reed_clump = -1;              // reed_model cards (alpha), at the reeds' mean grey
 };
 
 // The procedural textures, or where options.photographs asks for them the photographs of the
@@ -152,6 +153,12 @@ Textures add_textures(sim::SceneGeometry* g, std::uint64_t seed, const RiverReac
     Rng r = streams.stream(fmt::format("scene.texture.leaves_{}", name));
     *index = static_cast<int>(g->textures.size());
     g->textures.push_back(make_leaf_cluster(shape, &r, foliage_grey, kLeafGreyContrast));
+  }
+  if (o.reed_model == ReedModel::kCards) {
+    Rng r = streams.stream("scene.texture.reeds_clump");
+    t.reed_clump = static_cast<int>(g->textures.size());
+    g->textures.push_back(make_reed_clump(
+        &r, mean_gray(g->textures[static_cast<std::size_t>(t.reeds)]), kLeafGreyContrast));
   }
   return t;
 }
@@ -658,6 +665,71 @@ std::vector<TreeSpec> plan_trees(const RiverReachOptions& o, const Bank& k, cons
   return trees;
 }
 
+// Reeds: clumps straddling the water's edge, fewer with lower vegetation density; none at the
+// quay or the bridge. reed_model blades: thin two-sided blades (single triangles, so the tops
+// are ragged without alpha textures); cards: three crossed alpha-tested cards a clump. Either
+// bends from its foot (texture v = 1) to its tip (v = 0): psi = (1 - v)^2, a reed's tip as
+// compliant as a tall tree's top, and fluttering at half a leaf's.
+void add_reeds(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k, const Noise& n,
+               const Textures& tex, const RiverReachOptions& options, std::uint64_t seed,
+               int index) {
+  const bool cards = options.reed_model == ReedModel::kCards;
+  MeshBuilder reeds(tile_name(index, "reeds"), material(cards ? tex.reed_clump : tex.reeds, 0.85f));
+  Rng rr = RngStreams(seed).stream("scene.river.tile." + std::to_string(index) + ".reeds");
+  const int clumps =
+      static_cast<int>(std::round(options.vegetation_density * options.reach_length_m / 2.5));
+  for (int side : {1, -1})
+    for (int c = 0; c < clumps; ++c) {
+      const double x = rr.uniform(L.x0_m, L.x1_m), s = rr.uniform(-0.6, 0.8);
+      const double height = rr.uniform(1.0, 2.0), radius = rr.uniform(0.3, 0.7);
+      const bool skip = (L.quay && side > 0 && x > L.quay_x0_m - 1.0 && x < L.quay_x1_m + 1.0) ||
+                        (L.bridge && std::abs(x - L.bridge_x_m) < L.bridge_half_width_m + 1.0);
+      if (cards) {
+        const double phase = rr.uniform(0.0, kPi / 3);
+        if (skip) continue;
+        const double zg = terrain_z(k, n, x, s, side);
+        const double foot = zg + 0.2, top = std::min(zg, 0.0) - height;
+        const Vec3 centre(x, side * (k.b + s), 0.5 * (foot + top));
+        for (int card = 0; card < 3; ++card) {
+          const double a = phase + card * kPi / 3;
+          const Vec3 u(std::cos(a), std::sin(a), 0);
+          reeds.card(centre, 1.2 * radius * u, Vec3(0, 0, 0.5 * (foot - top)),
+                     Vec3(-u.y(), u.x(), 0));
+        }
+        continue;
+      }
+      for (int blade = 0; blade < kReedBlades; ++blade) {
+        // Every blade draws its numbers, kept or not, so skipping a clump
+        // leaves the next clumps unchanged.
+        const double r = radius * std::sqrt(rr.uniform()), phi = rr.uniform(0.0, 2 * kPi);
+        const double face = rr.uniform(0.0, kPi), h = height * rr.uniform(0.6, 1.0);
+        const double lean_x = rr.uniform(-0.25, 0.25), lean_y = rr.uniform(-0.25, 0.25);
+        const double half_w = rr.uniform(0.03, 0.06);
+        if (skip) continue;
+        const double bx = x + r * std::cos(phi), sb = s + r * std::sin(phi);
+        const double zg = terrain_z(k, n, bx, sb, side);
+        const Vec3 base(bx, side * (k.b + sb), zg + 0.2);
+        const Vec3 across(std::cos(face) * half_w, std::sin(face) * half_w, 0);
+        const Vec3 tip(bx + lean_x, base.y() + lean_y, std::min(zg, 0.0) - h);
+        const Vec3 nrm = (base + across - tip).cross(base - across - tip);
+        for (const Vec3& nn : {nrm, Vec3(-nrm)}) {
+          // A narrow strip of the reed texture, a different one per blade.
+          const double u0 = face / kPi;
+          const auto a = reeds.vertex(base - across, nn, u0, 1.0);
+          const auto b = reeds.vertex(base + across, nn, u0 + 0.08, 1.0);
+          const auto t = reeds.vertex(tip, nn, u0 + 0.04, 0.0);
+          reeds.triangle(a, b, t, nn);
+        }
+      }
+    }
+  sim::Mesh reed_mesh = reeds.take();
+  for (const sim::Vertex& v : reed_mesh.vertices) {
+    const float h = 1.f - v.v;
+    reed_mesh.sway.push_back({h * h, 0.5f * h});
+  }
+  add_mesh(g, std::move(reed_mesh));
+}
+
 // Bushes (willow scrub) on the bank between the reeds and the tree line,
 // drawn after the trees so that they do not move them.
 std::vector<TreeSpec> plan_bushes(const RiverReachOptions& o, const Bank& k, const Noise& n,
@@ -866,50 +938,7 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
       add_mesh(&g, bushes.take());
     }
 
-    // Reeds: clumps of thin two-sided blades (single triangles, so the tops
-    // are ragged without alpha textures) straddling the water's edge, fewer
-    // with lower vegetation density; none at the quay or the bridge.
-    MeshBuilder reeds(tile_name(index, "reeds"), material(tex.reeds, 0.85f));
-    Rng rr = RngStreams(seed).stream("scene.river.tile." + std::to_string(index) + ".reeds");
-    const int clumps = static_cast<int>(std::round(options.vegetation_density * len / 2.5));
-    for (int side : {1, -1})
-      for (int c = 0; c < clumps; ++c) {
-        const double x = rr.uniform(L.x0_m, L.x1_m), s = rr.uniform(-0.6, 0.8);
-        const double height = rr.uniform(1.0, 2.0), radius = rr.uniform(0.3, 0.7);
-        const bool skip = (L.quay && side > 0 && x > L.quay_x0_m - 1.0 && x < L.quay_x1_m + 1.0) ||
-                          (L.bridge && std::abs(x - L.bridge_x_m) < L.bridge_half_width_m + 1.0);
-        for (int blade = 0; blade < kReedBlades; ++blade) {
-          // Every blade draws its numbers, kept or not, so skipping a clump
-          // leaves the next clumps unchanged.
-          const double r = radius * std::sqrt(rr.uniform()), phi = rr.uniform(0.0, 2 * kPi);
-          const double face = rr.uniform(0.0, kPi), h = height * rr.uniform(0.6, 1.0);
-          const double lean_x = rr.uniform(-0.25, 0.25), lean_y = rr.uniform(-0.25, 0.25);
-          const double half_w = rr.uniform(0.03, 0.06);
-          if (skip) continue;
-          const double bx = x + r * std::cos(phi), sb = s + r * std::sin(phi);
-          const double zg = terrain_z(k, n, bx, sb, side);
-          const Vec3 base(bx, side * (k.b + sb), zg + 0.2);
-          const Vec3 across(std::cos(face) * half_w, std::sin(face) * half_w, 0);
-          const Vec3 tip(bx + lean_x, base.y() + lean_y, std::min(zg, 0.0) - h);
-          const Vec3 nrm = (base + across - tip).cross(base - across - tip);
-          for (const Vec3& nn : {nrm, Vec3(-nrm)}) {
-            // A narrow strip of the reed texture, a different one per blade.
-            const double u0 = face / kPi;
-            const auto a = reeds.vertex(base - across, nn, u0, 1.0);
-            const auto b = reeds.vertex(base + across, nn, u0 + 0.08, 1.0);
-            const auto t = reeds.vertex(tip, nn, u0 + 0.04, 0.0);
-            reeds.triangle(a, b, t, nn);
-          }
-        }
-      }
-    sim::Mesh reed_mesh = reeds.take();
-    // A blade bends from its foot (texture v = 1) to its tip (v = 0): psi = (1 - v)^2, a reed's
-    // tip as compliant as a tall tree's top, and fluttering at half a leaf's.
-    for (const sim::Vertex& v : reed_mesh.vertices) {
-      const float h = 1.f - v.v;
-      reed_mesh.sway.push_back({h * h, 0.5f * h});
-    }
-    add_mesh(&g, std::move(reed_mesh));
+    add_reeds(&g, L, k, n, tex, options, seed, index);
 
     if (L.bridge) add_bridge(&g, L, k, n, tex);
     if (L.quay) add_quay(&g, L, k, tex);

@@ -24,6 +24,11 @@ constexpr auto enum_table(TreeModel) {
                     std::pair{TreeModel::kEllipsoid, "ellipsoid"}};
 }
 
+enum class ReedModel { kBlades, kCards };
+constexpr auto enum_table(ReedModel) {
+  return std::array{std::pair{ReedModel::kBlades, "blades"}, std::pair{ReedModel::kCards, "cards"}};
+}
+
 enum class Sky { kOvercast, kSun };
 constexpr auto enum_table(Sky) {
   return std::array{std::pair{Sky::kOvercast, "overcast"}, std::pair{Sky::kSun, "sun"}};
@@ -80,6 +85,7 @@ struct RiverReachOptions {
   double vegetation_density = 0.6;
   TreeModel tree_model = TreeModel::kSkeleton;
   int leaf_cards_per_tree = 60;
+  ReedModel reed_model = ReedModel::kBlades;
   double tree_detail_distance_m = 7.0;
   double texture_contrast = 2.0;
   bool photographs = true;
@@ -146,6 +152,10 @@ struct RiverReachOptions {
       "Leaf-cluster cards on a near tree (half as many, each twice the area, at the mid level "
       "of detail); skeleton trees only",
       yaml::in_range(8, 400));
+    a("reed_model", reed_model,
+      "blades: each clump 14 single-triangle blades in the reed texture; cards: three "
+      "alpha-tested cards crossed at 60 deg, each a drawn clump of tapering blades "
+      "(scenes/leaf_textures.hpp), the strip cards of docs/renderer-and-scenes.md");
     a("tree_detail_distance_m", tree_detail_distance_m,
       "Trees at most this far behind the water's edge get twigs and the full set of cards; "
       "those further back three-sided limbs and half the cards (skeleton trees only)",

@@ -709,6 +709,48 @@ TEST(RiverReach, VegetationSwaysAndTheRestIsRigid) {
   EXPECT_NEAR(stem.sway[2][0], 10.0 / 12, 1e-6);
 }
 
+// reed_model cards: each clump three crossed upright cards in the drawn reed-clump texture
+// (alpha), feet in the bank and tops above the water, as many clumps as the blades' within the
+// quay's and bridge's gaps (6 triangles a clump against 28; the clumps' places are drawn from
+// the same stream, which the blades advance further), bending from the foot as the blades do.
+TEST(RiverReach, ReedCardsAreThreeCrossedUprightCardsAClump) {
+  RiverReachOptions o = river_defaults();
+  o.reed_model = ReedModel::kCards;
+  const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
+  const sim::Mesh* cards = find_mesh(g, "tile0.reeds");
+  const sim::Mesh* blades = find_mesh(default_reach(), "tile0.reeds");
+  ASSERT_TRUE(cards && blades);
+  ASSERT_GE(cards->material.texture, 0);
+  const sim::Texture& t = g.textures[static_cast<std::size_t>(cards->material.texture)];
+  EXPECT_EQ(t.name, "reeds_clump");
+  EXPECT_FALSE(t.alpha.empty());
+  EXPECT_TRUE(cards->material.double_sided);
+  ASSERT_EQ(cards->indices.size() % 18, 0u);
+  const double clumps = static_cast<double>(blades->indices.size()) / (3 * 28);
+  EXPECT_NEAR(static_cast<double>(cards->indices.size()) / 18, clumps, 0.1 * clumps);
+  ASSERT_EQ(cards->sway.size(), cards->vertices.size());
+  for (std::size_t i = 0; i < cards->vertices.size(); ++i) {
+    const sim::Vertex& v = cards->vertices[i];
+    EXPECT_NEAR(v.nz, 0.f, 1e-6);  // upright: the normal is horizontal
+    const float h = 1.f - v.v;
+    EXPECT_EQ(cards->sway[i][0], h * h);
+    if (v.v == 0.f) {
+      EXPECT_LT(v.z, -0.99f);  // the top at least 1 m above the water
+    }
+  }
+  // A card's four corners (MeshBuilder::card: v 0, 0, 1, 1): 1-2 m of reed above the water or
+  // the bank, its foot 0.2 m into the ground.
+  for (std::size_t q = 0; q + 3 < cards->vertices.size(); q += 4) {
+    const sim::Vertex &top = cards->vertices[q], &foot = cards->vertices[q + 3];
+    ASSERT_EQ(top.v, 0.f);
+    ASSERT_EQ(foot.v, 1.f);
+    EXPECT_GE(foot.z - top.z, 1.2f - 1e-4f);
+    EXPECT_LE(foot.z - top.z, 3.0f);
+  }
+  // The default scene does not carry the clump texture.
+  for (const sim::Texture& d : default_reach().textures) EXPECT_NE(d.name, "reeds_clump");
+}
+
 TEST(OtherVessels, MoveAsTheirOptionsSay) {
   OtherVesselOptions launch;
   launch.north_m = 70;

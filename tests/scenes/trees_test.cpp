@@ -266,6 +266,39 @@ TEST(LeafTextures, CoverageBorderAndDilation) {
   }
 }
 
+TEST(LeafTextures, ReedClumpCoverageBorderGreyAndSeed) {
+  Rng rng = RngStreams(11).stream("scene.texture.reeds_clump");
+  const sim::Texture t = make_reed_clump(&rng, 80.0, 0.3);
+  EXPECT_EQ(t.name, "reeds_clump");
+  ASSERT_EQ(t.width, 256);
+  ASSERT_EQ(t.alpha.size(), 256u * 256u);
+  const double c = coverage(t);
+  EXPECT_GE(c, reed_target_coverage());
+  EXPECT_LE(c, reed_target_coverage() + 0.03);
+  const int w = t.width;
+  int border = 0;
+  double sum = 0;
+  long opaque = 0, lower = 0;
+  for (int y = 0; y < w; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      if (x < 2 || y < 2 || x >= w - 2 || y >= w - 2) border += t.alpha[i];
+      if (t.alpha[i] < sim::kAlphaOpaqueFrom) continue;
+      sum += t.pixels[i], ++opaque;
+      lower += y >= w / 2 ? 1 : 0;
+    }
+  EXPECT_EQ(border, 0);
+  EXPECT_NEAR(sum / static_cast<double>(opaque), 80.0, 1.0);
+  // Blades taper from their feet at the bottom edge: most of the cover is in the lower half.
+  EXPECT_GT(static_cast<double>(lower) / static_cast<double>(opaque), 0.6);
+  Rng a = RngStreams(1).stream("x"), b = RngStreams(1).stream("x"), d = RngStreams(2).stream("x");
+  const sim::Texture ta = make_reed_clump(&a, 90, 0.3), tb = make_reed_clump(&b, 90, 0.3),
+                     td = make_reed_clump(&d, 90, 0.3);
+  EXPECT_EQ(ta.alpha, tb.alpha);
+  EXPECT_EQ(ta.pixels, tb.pixels);
+  EXPECT_NE(ta.alpha, td.alpha);
+}
+
 TEST(LeafTextures, SameSeedSameBytesOtherSeedOtherBytes) {
   for (LeafShape shape : {LeafShape::kBroad, LeafShape::kNarrow}) {
     Rng a = RngStreams(1).stream("x"), b = RngStreams(1).stream("x"), c = RngStreams(2).stream("x");
