@@ -229,13 +229,20 @@ void add_terrain(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k,
 // ---------------------------------------------------------------------------
 // Trees: a 6-sided trunk and a lumpy ellipsoidal crown.
 
-// A lumpy ellipsoid whose apex is at the tree's height and whose vertical
-// semi-axis is `a_frac` x the height (0.38 for a tree, 0.5 for a bush sitting
-// on the ground).
-void add_crown(MeshBuilder* mb, const TreeSpec& t, double a_frac, Rng* lumps) {
-  constexpr int kSides = 9, kBands = 6;
-  const double a = a_frac * t.height_m;
-  const Vec3 c = t.base_W - Vec3(0, 0, t.height_m - a);
+// What a lumpy ellipsoid looks like: its grid (sides around, bands pole to pole), the range of
+// the random scale of its vertices off the poles, and one texture repeat every repeat_m.
+struct Lumps {
+  int sides = 9, bands = 6;
+  double lo = 0.85, hi = 1.15;
+  double repeat_m = 3.0;
+};
+
+// A lumpy ellipsoid centred at c, horizontal semi-axis r and vertical a: the poles exact, the
+// other vertices scaled by uniform(lo, hi) so that it does not look machine-made; u wraps
+// around (whole repeats), v runs from the upper pole down.
+void add_lumpy_ellipsoid(MeshBuilder* mb, const Vec3& c, double r, double a, const Lumps& form,
+                         Rng* lumps) {
+  const int kSides = form.sides, kBands = form.bands;
   std::vector<Vec3> P(static_cast<std::size_t>((kBands + 1) * kSides));
   auto at = [&](int j, int i) -> Vec3& {
     return P[static_cast<std::size_t>(j * kSides + ((i % kSides) + kSides) % kSides)];
@@ -243,17 +250,14 @@ void add_crown(MeshBuilder* mb, const TreeSpec& t, double a_frac, Rng* lumps) {
   for (int j = 0; j <= kBands; ++j) {
     const double th = kPi * j / kBands;
     for (int i = 0; i < kSides; ++i) {
-      // Poles stay exact (the apex is the tree's top); other vertices get
-      // +-15% lumps so crowns do not look machine-made.
-      const double f = (j == 0 || j == kBands) ? 1.0 : lumps->uniform(0.85, 1.15);
+      const double f = (j == 0 || j == kBands) ? 1.0 : lumps->uniform(form.lo, form.hi);
       const double ph = 2 * kPi * i / kSides;
-      at(j, i) =
-          c + Vec3(t.crown_radius_m * f * std::sin(th) * std::cos(ph),
-                   t.crown_radius_m * f * std::sin(th) * std::sin(ph), -a * f * std::cos(th));
+      at(j, i) = c + Vec3(r * f * std::sin(th) * std::cos(ph), r * f * std::sin(th) * std::sin(ph),
+                          -a * f * std::cos(th));
     }
   }
-  const double u_repeats = std::max(1.0, std::round(2 * kPi * t.crown_radius_m / 3.0));
-  const double v_len = kPi * 0.5 * (t.crown_radius_m + a) / 3.0;
+  const double u_repeats = std::max(1.0, std::round(2 * kPi * r / form.repeat_m));
+  const double v_len = kPi * 0.5 * (r + a) / form.repeat_m;
   std::vector<std::uint32_t> id(static_cast<std::size_t>((kBands + 1) * (kSides + 1)));
   auto vid = [&](int j, int i) -> std::uint32_t& {
     return id[static_cast<std::size_t>(j * (kSides + 1) + i)];
@@ -277,6 +281,15 @@ void add_crown(MeshBuilder* mb, const TreeSpec& t, double a_frac, Rng* lumps) {
       if (j > 0) mb->triangle(vid(j, i), vid(j, i + 1), vid(j + 1, i + 1), mid);
       if (j + 1 < kBands) mb->triangle(vid(j, i), vid(j + 1, i + 1), vid(j + 1, i), mid);
     }
+}
+
+// A lumpy ellipsoid whose apex is at the tree's height and whose vertical
+// semi-axis is `a_frac` x the height (0.38 for a tree, 0.5 for a bush sitting
+// on the ground).
+void add_crown(MeshBuilder* mb, const TreeSpec& t, double a_frac, Rng* lumps) {
+  const double a = a_frac * t.height_m;
+  add_lumpy_ellipsoid(mb, t.base_W - Vec3(0, 0, t.height_m - a), t.crown_radius_m, a, Lumps{},
+                      lumps);
 }
 
 // ---------------------------------------------------------------------------
@@ -730,6 +743,51 @@ void add_reeds(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k, c
   add_mesh(g, std::move(reed_mesh));
 }
 
+// Stones at the water's edge (waterline_stones_per_m a metre of bank on each side): lumpy
+// flattened ellipsoids, most small and a few large (radius 0.08 + 0.35 u^2 m), sunk by a third
+// of their height into the bank or the river bed on either side of the water line, in the
+// soil's grain (the photographs have no stones of this size); none at the quay or the
+// bridge. Faceted (a normal a face), so that the overcast light from above breaks each one into
+// lit tops and darker flanks.
+void add_waterline_stones(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k,
+                          const Noise& n, const Textures& tex, const RiverReachOptions& options,
+                          std::uint64_t seed, int index) {
+  if (options.waterline_stones_per_m <= 0) return;
+  MeshBuilder smooth(tile_name(index, "stones"), solid(tex.soil, 0.8f));
+  Rng rs = RngStreams(seed).stream("scene.river.tile." + std::to_string(index) + ".stones");
+  const int count =
+      static_cast<int>(std::round(options.waterline_stones_per_m * options.reach_length_m));
+  const Lumps form{5, 3, 0.75, 1.25, 0.3};
+  for (int side : {1, -1})
+    for (int i = 0; i < count; ++i) {
+      const double x = rs.uniform(L.x0_m, L.x1_m), s = rs.uniform(-0.5, 0.6);
+      const double u = rs.uniform(), r = 0.08 + 0.35 * u * u, a = r * rs.uniform(0.45, 0.8);
+      if ((L.quay && side > 0 && x > L.quay_x0_m - 1.0 && x < L.quay_x1_m + 1.0) ||
+          (L.bridge && std::abs(x - L.bridge_x_m) < L.bridge_half_width_m + 1.0))
+        continue;
+      const Vec3 c(x, side * (k.b + s), terrain_z(k, n, x, s, side) + a / 3);
+      add_lumpy_ellipsoid(&smooth, c, r, a, form, &rs);
+    }
+  const sim::Mesh m = smooth.take();
+  MeshBuilder stones(m.name, m.material);
+  for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+    std::array<Vec3, 3> p;
+    for (int j = 0; j < 3; ++j) {
+      const sim::Vertex& v = m.vertices[m.indices[t + static_cast<std::size_t>(j)]];
+      p[static_cast<std::size_t>(j)] = Vec3(v.x, v.y, v.z);
+    }
+    const Vec3 nrm = (p[1] - p[0]).cross(p[2] - p[0]);
+    std::array<std::uint32_t, 3> id;
+    for (int j = 0; j < 3; ++j) {
+      const sim::Vertex& v = m.vertices[m.indices[t + static_cast<std::size_t>(j)]];
+      id[static_cast<std::size_t>(j)] =
+          stones.vertex(p[static_cast<std::size_t>(j)], nrm, v.u, v.v);
+    }
+    stones.triangle(id[0], id[1], id[2], nrm);
+  }
+  add_mesh(g, stones.take());
+}
+
 // Bushes (willow scrub) on the bank between the reeds and the tree line,
 // drawn after the trees so that they do not move them.
 std::vector<TreeSpec> plan_bushes(const RiverReachOptions& o, const Bank& k, const Noise& n,
@@ -939,6 +997,7 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
     }
 
     add_reeds(&g, L, k, n, tex, options, seed, index);
+    add_waterline_stones(&g, L, k, n, tex, options, seed, index);
 
     if (L.bridge) add_bridge(&g, L, k, n, tex);
     if (L.quay) add_quay(&g, L, k, tex);

@@ -86,6 +86,7 @@ struct RiverReachOptions {
   TreeModel tree_model = TreeModel::kSkeleton;
   int leaf_cards_per_tree = 60;
   ReedModel reed_model = ReedModel::kBlades;
+  double waterline_stones_per_m = 0;
   double tree_detail_distance_m = 7.0;
   double texture_contrast = 2.0;
   bool photographs = true;
@@ -156,6 +157,10 @@ struct RiverReachOptions {
       "blades: each clump 14 single-triangle blades in the reed texture; cards: three "
       "alpha-tested cards crossed at 60 deg, each a drawn clump of tapering blades "
       "(scenes/leaf_textures.hpp), the strip cards of docs/renderer-and-scenes.md");
+    a("waterline_stones_per_m", waterline_stones_per_m,
+      "Stones at the water's edge per metre of bank on each side (lumpy flattened ellipsoids of "
+      "0.08-0.43 m radius, sunk a third into the bank or the river bed); 0: none",
+      yaml::in_range(0, 5));
     a("tree_detail_distance_m", tree_detail_distance_m,
       "Trees at most this far behind the water's edge get twigs and the full set of cards; "
       "those further back three-sided limbs and half the cards (skeleton trees only)",

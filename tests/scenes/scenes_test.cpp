@@ -751,6 +751,46 @@ TEST(RiverReach, ReedCardsAreThreeCrossedUprightCardsAClump) {
   for (const sim::Texture& d : default_reach().textures) EXPECT_NE(d.name, "reeds_clump");
 }
 
+// waterline_stones_per_m: that many stones a metre of bank on each side (less the quay's and
+// the bridge's gaps), each a faceted lump within 0.43 m of its centre near the water's edge;
+// none by default.
+TEST(RiverReach, WaterlineStonesLieAtTheWatersEdge) {
+  EXPECT_FALSE(find_mesh(default_reach(), "tile0.stones"));
+  RiverReachOptions o = river_defaults();
+  o.waterline_stones_per_m = 1.0;
+  const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
+  const sim::Mesh* stones = find_mesh(g, "tile0.stones");
+  ASSERT_TRUE(stones);
+  // A lump of 5 sides and 3 bands: 5 triangles at each pole band and 10 in the middle one.
+  constexpr std::size_t kTriangles = 20;
+  const std::size_t n = stones->indices.size() / (3 * kTriangles);
+  ASSERT_EQ(stones->indices.size() % (3 * kTriangles), 0u);
+  // Uniform along the tile: the expected count less the quay's (one side) and the bridge's
+  // (both sides) gaps, each 1 m wider at both ends; binomial spread.
+  const RiverTileLayout L = plan_river_tile(o, kSeed, 0);
+  const double len = L.x1_m - L.x0_m, per_side = o.waterline_stones_per_m * o.reach_length_m;
+  const double quay = L.quay ? (L.quay_x1_m - L.quay_x0_m + 2) / len : 0;
+  const double bridge = L.bridge ? 2 * (L.bridge_half_width_m + 1) / len : 0;
+  const double expected = per_side * ((1 - quay - bridge) + (1 - bridge));
+  EXPECT_NEAR(static_cast<double>(n), expected, 4 * std::sqrt(expected)) << quay << " " << bridge;
+  const double edge = o.river_width_m / 2;
+  for (std::size_t t = 0; t < stones->indices.size(); t += 3) {
+    const sim::Vertex& a = stones->vertices[stones->indices[t]];
+    const sim::Vertex& b = stones->vertices[stones->indices[t + 1]];
+    const sim::Vertex& c = stones->vertices[stones->indices[t + 2]];
+    // Faceted: the three corners carry the face's normal.
+    const Vec3 face = (Vec3(b.x - a.x, b.y - a.y, b.z - a.z))
+                          .cross(Vec3(c.x - a.x, c.y - a.y, c.z - a.z))
+                          .normalized();
+    for (const sim::Vertex* v : {&a, &b, &c}) {
+      EXPECT_NEAR(std::abs(Vec3(v->nx, v->ny, v->nz).dot(face)), 1.0, 1e-4);
+      // Within the stones' band about the water's edge (s in [-0.5, 0.6] m), and low.
+      EXPECT_NEAR(std::abs(v->y), edge + 0.05, 0.55 + 0.43 * 1.25 + 1e-3);
+      EXPECT_GT(v->z, -2.0f);
+    }
+  }
+}
+
 TEST(OtherVessels, MoveAsTheirOptionsSay) {
   OtherVesselOptions launch;
   launch.north_m = 70;
