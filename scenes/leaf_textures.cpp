@@ -327,4 +327,41 @@ sim::Texture make_reed_clump(Rng* rng, double mean_grey, double contrast, int si
   return finish_texture(c, "reeds_clump", mean_grey);
 }
 
+double billboard_target_coverage() { return 0.35; }
+
+sim::Texture make_tree_billboard(Rng* rng, double mean_grey, double contrast, int size_px) {
+  DRIFTLAB_DEMAND_MSG(size_px >= 64 && size_px <= 4096, "tree billboard size must be 64-4096 px");
+  DRIFTLAB_DEMAND_MSG(mean_grey >= 0 && mean_grey <= 255 && contrast >= 0,
+                      "tree billboard needs mean_grey in [0, 255] and contrast >= 0");
+  const double size = size_px, scale = size_px / 256.0;
+  Canvas c(size_px);
+  // A trunk from the bottom edge into the crown, then the crown: broad leaves at twice a near
+  // cluster's size (a far tree's leaf clusters), scattered normally about the crown's
+  // centre, the upper side lighter, until the opaque share reaches the target.
+  const double cx = size * rng->uniform(0.45, 0.55);
+  paint(&c, capsule(Vec2(cx, size * 0.985), Vec2(cx, size * 0.45), 4.0 * scale, kTwigGrey));
+  const Vec2 centre(cx, size * rng->uniform(0.38, 0.42));
+  const double sx = size * rng->uniform(0.10, 0.12), sy = size * rng->uniform(0.10, 0.12);
+  const long target = static_cast<long>(
+      std::ceil(billboard_target_coverage() * static_cast<double>(size_px) * size_px));
+  for (int iter = 0; c.opaque < target; ++iter) {
+    DRIFTLAB_DEMAND_MSG(iter < 100000, "tree billboard did not reach its coverage");
+    Shape leaf;
+    leaf.leaf = true;
+    leaf.kind = LeafShape::kBroad;
+    leaf.a = centre + Vec2(sx * rng->normal(), sy * rng->normal());
+    const double ang = rng->uniform(0.0, 2 * std::numbers::pi);
+    leaf.dir = Vec2(std::cos(ang), std::sin(ang));
+    leaf.length = 2 * scale * rng->uniform(18, 24);
+    leaf.width = 2 * scale * rng->uniform(14, 18);
+    const double up = std::clamp((centre.y() - leaf.a.y()) / (2 * sy), -1.0, 1.0);
+    leaf.grey = std::max(0.2, 1 + 0.15 * up + contrast * rng->normal());
+    const Vec2 tip = leaf.a + leaf.length * leaf.dir;
+    leaf.lo = leaf.a.cwiseMin(tip).array() - 0.5 * leaf.width;
+    leaf.hi = leaf.a.cwiseMax(tip).array() + 0.5 * leaf.width;
+    paint(&c, leaf);
+  }
+  return finish_texture(c, "tree_billboard", mean_grey);
+}
+
 }  // namespace driftlab::scenes

@@ -43,4 +43,14 @@ double reed_target_coverage();
 /// dilation as make_leaf_cluster's. Deterministic in `rng`. Named "reeds_clump".
 sim::Texture make_reed_clump(Rng* rng, double mean_grey, double contrast, int size_px = 256);
 
+/// The share of opaque texels a far tree's billboard is drawn to: 0.35.
+double billboard_target_coverage();
+
+/// A square far-tree billboard texture with alpha, for far_trees_per_m: a trunk from the middle
+/// of the bottom edge into a crown of broad leaf clusters (twice a near cluster's leaves)
+/// scattered normally about a centre at about 40 % of the height, lighter above, until
+/// billboard_target_coverage(). Alpha, border and dilation as make_leaf_cluster's.
+/// Deterministic in `rng`. Named "tree_billboard".
+sim::Texture make_tree_billboard(Rng* rng, double mean_grey, double contrast, int size_px = 256);
+
 }  // namespace driftlab::scenes

@@ -116,6 +116,7 @@ struct Textures {
   int grass, soil, bark, foliage, reeds, concrete, sheet, facade, roof, brick, stone;
   int leaves_broad, leaves_narrow;  // leaf-cluster cards (alpha), at the foliage's mean grey
   int reed_clump = -1;              // reed_model cards (alpha), at the reeds' mean grey
+  int tree_billboard = -1;          // far_trees_per_m (alpha), at the foliage's mean grey
 };
 
 // The procedural textures, or where options.photographs asks for them the photographs of the
@@ -153,6 +154,11 @@ Textures add_textures(sim::SceneGeometry* g, std::uint64_t seed, const RiverReac
     Rng r = streams.stream(fmt::format("scene.texture.leaves_{}", name));
     *index = static_cast<int>(g->textures.size());
     g->textures.push_back(make_leaf_cluster(shape, &r, foliage_grey, kLeafGreyContrast));
+  }
+  if (o.far_trees_per_m > 0) {
+    Rng r = streams.stream("scene.texture.tree_billboard");
+    t.tree_billboard = static_cast<int>(g->textures.size());
+    g->textures.push_back(make_tree_billboard(&r, foliage_grey, kLeafGreyContrast));
   }
   if (o.reed_model == ReedModel::kCards) {
     Rng r = streams.stream("scene.texture.reeds_clump");
@@ -483,6 +489,34 @@ void add_far_field(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& 
   }
   add_mesh(g, wood.take());
   add_mesh(g, hills.take());
+}
+
+// Far trees (far_trees_per_m a metre of the far wood's front on each side): world-fixed crossed
+// billboards (two upright alpha-tested cards at right angles, never turned towards an eye or a
+// frame: the scene stays rigid for stereo), 10-16 m tall, growing out of the far wood's canopy
+// within 25 m of its front (their feet 6 m below the canopy), so that the wood's skyline breaks
+// into crowns.
+void add_far_trees(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k, const Noise& n,
+                   const Textures& tex, const RiverReachOptions& options, std::uint64_t seed,
+                   int side) {
+  if (options.far_trees_per_m <= 0) return;
+  MeshBuilder trees(tile_name(L.index, side > 0 ? "far_trees_east" : "far_trees_west"),
+                    material(tex.tree_billboard, 0.7f));
+  Rng rf = RngStreams(seed).stream(
+      fmt::format("scene.river.tile.{}.far_trees.{}", L.index, side > 0 ? "east" : "west"));
+  const int count = static_cast<int>(std::round(options.far_trees_per_m * options.reach_length_m));
+  const double s_edge = kFarFieldStart_m + 2.0;
+  for (int i = 0; i < count; ++i) {
+    const double x = rf.uniform(L.x0_m, L.x1_m), s = s_edge + rf.uniform(0.0, 25.0);
+    const double height = rf.uniform(10.0, 16.0), a = rf.uniform(0.0, kPi / 2);
+    const double foot = far_top_z(k, n, x, s, side) + 6.0;
+    const Vec3 centre(x, side * (k.b + s), foot - height / 2);
+    for (const double phi : {a, a + kPi / 2}) {
+      const Vec3 u(std::cos(phi), std::sin(phi), 0);
+      trees.card(centre, 0.35 * height * u, Vec3(0, 0, height / 2), Vec3(-u.y(), u.x(), 0));
+    }
+  }
+  add_mesh(g, trees.take());
 }
 
 // A wooded river bend closing the valley at x = x_end, facing `facing` (+1:
@@ -1002,7 +1036,10 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
     if (L.bridge) add_bridge(&g, L, k, n, tex);
     if (L.quay) add_quay(&g, L, k, tex);
     add_buildings(&g, L, tex);
-    for (int side : {1, -1}) add_far_field(&g, L, k, n, tex, side);
+    for (int side : {1, -1}) {
+      add_far_field(&g, L, k, n, tex, side);
+      add_far_trees(&g, L, k, n, tex, options, seed, side);
+    }
 
     sim::Mesh bollards;
     bollards.name = tile_name(index, "bollards");

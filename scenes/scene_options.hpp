@@ -87,6 +87,7 @@ struct RiverReachOptions {
   int leaf_cards_per_tree = 60;
   ReedModel reed_model = ReedModel::kBlades;
   double waterline_stones_per_m = 0;
+  double far_trees_per_m = 0;
   double tree_detail_distance_m = 7.0;
   double texture_contrast = 2.0;
   bool photographs = true;
@@ -161,6 +162,10 @@ struct RiverReachOptions {
       "Stones at the water's edge per metre of bank on each side (lumpy flattened ellipsoids of "
       "0.08-0.43 m radius, sunk a third into the bank or the river bed); 0: none",
       yaml::in_range(0, 5));
+    a("far_trees_per_m", far_trees_per_m,
+      "Far trees per metre of the far wood on each side: world-fixed crossed billboards, 10-16 m "
+      "tall, growing out of the wood's canopy within 25 m of its front; 0: none",
+      yaml::in_range(0, 2));
     a("tree_detail_distance_m", tree_detail_distance_m,
       "Trees at most this far behind the water's edge get twigs and the full set of cards; "
       "those further back three-sided limbs and half the cards (skeleton trees only)",

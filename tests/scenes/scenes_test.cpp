@@ -791,6 +791,38 @@ TEST(RiverReach, WaterlineStonesLieAtTheWatersEdge) {
   }
 }
 
+// far_trees_per_m: on each side that many trees a metre, each two upright cards at right angles
+// (world-fixed crossed billboards) 10-16 m tall and 0.7 of that wide in the billboard texture;
+// none by default.
+TEST(RiverReach, FarTreesAreCrossedUprightBillboards) {
+  EXPECT_FALSE(find_mesh(default_reach(), "tile0.far_trees_east"));
+  RiverReachOptions o = river_defaults();
+  o.far_trees_per_m = 0.25;
+  const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
+  for (const char* name : {"tile0.far_trees_east", "tile0.far_trees_west"}) {
+    const sim::Mesh* m = find_mesh(g, name);
+    ASSERT_TRUE(m) << name;
+    EXPECT_EQ(g.textures[static_cast<std::size_t>(m->material.texture)].name, "tree_billboard");
+    const std::size_t trees = std::lround(o.far_trees_per_m * o.reach_length_m);
+    ASSERT_EQ(m->vertices.size(), 8 * trees) << name;  // two cards of four corners a tree
+    for (std::size_t t = 0; t < trees; ++t) {
+      const sim::Vertex* v = &m->vertices[8 * t];
+      const Vec3 u0(v[1].x - v[0].x, v[1].y - v[0].y, v[1].z - v[0].z);
+      const Vec3 u1(v[5].x - v[4].x, v[5].y - v[4].y, v[5].z - v[4].z);
+      const double height = v[3].z - v[0].z;  // foot (v = 1) below top (v = 0)
+      EXPECT_NEAR(u0.z(), 0.0, 1e-4);         // the cards' u edges are level: upright cards
+      EXPECT_NEAR(u0.dot(u1), 0.0, 1e-3 * u0.squaredNorm());  // at right angles
+      EXPECT_GE(height, 10.0 - 1e-3);
+      EXPECT_LE(height, 16.0 + 1e-3);
+      EXPECT_NEAR(u0.norm(), 0.7 * height, 1e-3);
+      // Behind the far wood's front (2 m behind the far field's start), within 25 m of it.
+      const double y = std::abs(v[0].y + v[1].y + v[2].y + v[3].y) / 4;
+      EXPECT_GE(y, o.river_width_m / 2 + kFarFieldStart_m + 2 - 1e-3);
+      EXPECT_LE(y, o.river_width_m / 2 + kFarFieldStart_m + 27 + 1e-3);
+    }
+  }
+}
+
 TEST(OtherVessels, MoveAsTheirOptionsSay) {
   OtherVesselOptions launch;
   launch.north_m = 70;

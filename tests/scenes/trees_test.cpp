@@ -299,6 +299,32 @@ TEST(LeafTextures, ReedClumpCoverageBorderGreyAndSeed) {
   EXPECT_NE(ta.alpha, td.alpha);
 }
 
+TEST(LeafTextures, TreeBillboardCoverageBorderAndGrey) {
+  Rng rng = RngStreams(11).stream("scene.texture.tree_billboard");
+  const sim::Texture t = make_tree_billboard(&rng, 70.0, 0.3);
+  EXPECT_EQ(t.name, "tree_billboard");
+  const double c = coverage(t);
+  EXPECT_GE(c, billboard_target_coverage());
+  EXPECT_LE(c, billboard_target_coverage() + 0.03);
+  const int w = t.width;
+  int border = 0;
+  double sum = 0;
+  long opaque = 0;
+  for (int y = 0; y < w; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      if (x < 2 || y < 2 || x >= w - 2 || y >= w - 2) border += t.alpha[i];
+      if (t.alpha[i] >= sim::kAlphaOpaqueFrom) sum += t.pixels[i], ++opaque;
+    }
+  EXPECT_EQ(border, 0);
+  EXPECT_NEAR(sum / static_cast<double>(opaque), 70.0, 1.0);
+  // The trunk reaches the bottom: an opaque texel in the bottom rows' middle.
+  bool trunk = false;
+  for (int x = w / 3; x < 2 * w / 3; ++x)
+    trunk |= t.alpha[(w - 4) * w + x] >= sim::kAlphaOpaqueFrom;
+  EXPECT_TRUE(trunk);
+}
+
 TEST(LeafTextures, SameSeedSameBytesOtherSeedOtherBytes) {
   for (LeafShape shape : {LeafShape::kBroad, LeafShape::kNarrow}) {
     Rng a = RngStreams(1).stream("x"), b = RngStreams(1).stream("x"), c = RngStreams(2).stream("x");
