@@ -10,6 +10,8 @@
 
 #include <Eigen/Core>
 
+#include <fmt/format.h>
+
 #include "core/error.hpp"
 
 namespace driftlab::scenes {
@@ -225,6 +227,35 @@ void dilate_grey(const std::vector<std::uint8_t>& alpha, int size, std::vector<s
   }
 }
 
+// The arguments every drawn cutout texture checks (`what` names it in the message), and the
+// number of opaque texels its share of the texture is.
+long checked_target(const char* what, int size_px, double mean_grey, double contrast,
+                    double share) {
+  DRIFTLAB_DEMAND_MSG(size_px >= 64 && size_px <= 4096,
+                      fmt::format("{} size must be 64-4096 px", what));
+  DRIFTLAB_DEMAND_MSG(mean_grey >= 0 && mean_grey <= 255 && contrast >= 0,
+                      fmt::format("{} needs mean_grey in [0, 255] and contrast >= 0", what));
+  return static_cast<long>(std::ceil(share * static_cast<double>(size_px) * size_px));
+}
+
+// A leaf-profiled shape from its base `a` along the unit `dir`, its bounding box set.
+Shape leaf_shape(LeafShape kind, const Vec2& a, const Vec2& dir, double length, double width,
+                 double widest, double grey) {
+  Shape leaf;
+  leaf.leaf = true;
+  leaf.kind = kind;
+  leaf.a = a;
+  leaf.dir = dir;
+  leaf.length = length;
+  leaf.width = width;
+  leaf.widest = widest;
+  leaf.grey = grey;
+  const Vec2 tip = a + length * dir;
+  leaf.lo = a.cwiseMin(tip).array() - 0.5 * width;
+  leaf.hi = a.cwiseMax(tip).array() + 0.5 * width;
+  return leaf;
+}
+
 // The texture of a painted canvas: alpha from the subsamples, each texel's grey the mean of its
 // inside subsamples scaled so that the opaque texels' mean is mean_grey, transparent texels
 // dilated.
@@ -264,14 +295,11 @@ double leaf_target_coverage(LeafShape shape) { return shape == LeafShape::kBroad
 
 sim::Texture make_leaf_cluster(LeafShape shape, Rng* rng, double mean_grey, double contrast,
                                int size_px) {
-  DRIFTLAB_DEMAND_MSG(size_px >= 64 && size_px <= 4096, "leaf cluster size must be 64-4096 px");
-  DRIFTLAB_DEMAND_MSG(mean_grey >= 0 && mean_grey <= 255 && contrast >= 0,
-                      "leaf cluster needs mean_grey in [0, 255] and contrast >= 0");
+  const long target =
+      checked_target("leaf cluster", size_px, mean_grey, contrast, leaf_target_coverage(shape));
   const double scale = size_px / 256.0;
   Canvas c(size_px);
   const std::vector<Segment> segs = draw_twigs(&c, rng, scale);
-  const long texels = static_cast<long>(size_px) * size_px;
-  const long target = static_cast<long>(std::ceil(leaf_target_coverage(shape) * texels));
   // Greedy fill: of 4 candidate leaves the one covering most new area is drawn, so the leaves
   // spread into the gaps; the petioles grow longer when no candidate finds much room.
   double petiole_max = 4 * scale;
@@ -297,32 +325,21 @@ sim::Texture make_leaf_cluster(LeafShape shape, Rng* rng, double mean_grey, doub
 double reed_target_coverage() { return 0.30; }
 
 sim::Texture make_reed_clump(Rng* rng, double mean_grey, double contrast, int size_px) {
-  DRIFTLAB_DEMAND_MSG(size_px >= 64 && size_px <= 4096, "reed clump size must be 64-4096 px");
-  DRIFTLAB_DEMAND_MSG(mean_grey >= 0 && mean_grey <= 255 && contrast >= 0,
-                      "reed clump needs mean_grey in [0, 255] and contrast >= 0");
+  const long target =
+      checked_target("reed clump", size_px, mean_grey, contrast, reed_target_coverage());
   const double size = size_px, scale = size_px / 256.0;
   Canvas c(size_px);
-  const long target =
-      static_cast<long>(std::ceil(reed_target_coverage() * static_cast<double>(size_px) * size_px));
   // Blades from a narrow foot at the bottom edge, fanning out up to 28 deg from the vertical,
   // widest at the foot and tapering to a point (Shape's lanceolate profile with its widest
   // point at the foot), until the opaque share reaches the target.
   for (int iter = 0; c.opaque < target; ++iter) {
     DRIFTLAB_DEMAND_MSG(iter < 100000, "reed clump did not reach its coverage");
-    Shape blade;
-    blade.leaf = true;
-    blade.kind = LeafShape::kNarrow;
-    blade.widest = 0;
-    blade.a = Vec2(size * rng->uniform(0.3, 0.7), size * 0.985);
+    const Vec2 foot(size * rng->uniform(0.3, 0.7), size * 0.985);
     const double lean = rng->uniform(-28, 28) * kDeg;
-    blade.dir = Vec2(std::sin(lean), -std::cos(lean));
-    blade.length = size * rng->uniform(0.45, 0.95);
-    blade.width = scale * rng->uniform(5, 9);
-    blade.grey = std::max(0.2, 1 + contrast * rng->normal());
-    const Vec2 tip = blade.a + blade.length * blade.dir;
-    blade.lo = blade.a.cwiseMin(tip).array() - 0.5 * blade.width;
-    blade.hi = blade.a.cwiseMax(tip).array() + 0.5 * blade.width;
-    paint(&c, blade);
+    const double length = size * rng->uniform(0.45, 0.95), width = scale * rng->uniform(5, 9);
+    const double grey = std::max(0.2, 1 + contrast * rng->normal());
+    paint(&c, leaf_shape(LeafShape::kNarrow, foot, Vec2(std::sin(lean), -std::cos(lean)), length,
+                         width, 0, grey));
   }
   return finish_texture(c, "reeds_clump", mean_grey);
 }
@@ -330,9 +347,8 @@ sim::Texture make_reed_clump(Rng* rng, double mean_grey, double contrast, int si
 double billboard_target_coverage() { return 0.35; }
 
 sim::Texture make_tree_billboard(Rng* rng, double mean_grey, double contrast, int size_px) {
-  DRIFTLAB_DEMAND_MSG(size_px >= 64 && size_px <= 4096, "tree billboard size must be 64-4096 px");
-  DRIFTLAB_DEMAND_MSG(mean_grey >= 0 && mean_grey <= 255 && contrast >= 0,
-                      "tree billboard needs mean_grey in [0, 255] and contrast >= 0");
+  const long target =
+      checked_target("tree billboard", size_px, mean_grey, contrast, billboard_target_coverage());
   const double size = size_px, scale = size_px / 256.0;
   Canvas c(size_px);
   // A trunk from the bottom edge into the crown, then the crown: broad leaves at twice a near
@@ -342,24 +358,16 @@ sim::Texture make_tree_billboard(Rng* rng, double mean_grey, double contrast, in
   paint(&c, capsule(Vec2(cx, size * 0.985), Vec2(cx, size * 0.45), 4.0 * scale, kTwigGrey));
   const Vec2 centre(cx, size * rng->uniform(0.38, 0.42));
   const double sx = size * rng->uniform(0.10, 0.12), sy = size * rng->uniform(0.10, 0.12);
-  const long target = static_cast<long>(
-      std::ceil(billboard_target_coverage() * static_cast<double>(size_px) * size_px));
   for (int iter = 0; c.opaque < target; ++iter) {
     DRIFTLAB_DEMAND_MSG(iter < 100000, "tree billboard did not reach its coverage");
-    Shape leaf;
-    leaf.leaf = true;
-    leaf.kind = LeafShape::kBroad;
-    leaf.a = centre + Vec2(sx * rng->normal(), sy * rng->normal());
+    const Vec2 at = centre + Vec2(sx * rng->normal(), sy * rng->normal());
     const double ang = rng->uniform(0.0, 2 * std::numbers::pi);
-    leaf.dir = Vec2(std::cos(ang), std::sin(ang));
-    leaf.length = 2 * scale * rng->uniform(18, 24);
-    leaf.width = 2 * scale * rng->uniform(14, 18);
-    const double up = std::clamp((centre.y() - leaf.a.y()) / (2 * sy), -1.0, 1.0);
-    leaf.grey = std::max(0.2, 1 + 0.15 * up + contrast * rng->normal());
-    const Vec2 tip = leaf.a + leaf.length * leaf.dir;
-    leaf.lo = leaf.a.cwiseMin(tip).array() - 0.5 * leaf.width;
-    leaf.hi = leaf.a.cwiseMax(tip).array() + 0.5 * leaf.width;
-    paint(&c, leaf);
+    const double length = 2 * scale * rng->uniform(18, 24);
+    const double width = 2 * scale * rng->uniform(14, 18);
+    const double up = std::clamp((centre.y() - at.y()) / (2 * sy), -1.0, 1.0);
+    const double grey = std::max(0.2, 1 + 0.15 * up + contrast * rng->normal());
+    paint(&c, leaf_shape(LeafShape::kBroad, at, Vec2(std::cos(ang), std::sin(ang)), length, width,
+                         0.4, grey));
   }
   return finish_texture(c, "tree_billboard", mean_grey);
 }
