@@ -215,6 +215,29 @@ double coverage(const sim::Texture& t) {
   return static_cast<double>(n) / static_cast<double>(t.alpha.size());
 }
 
+// A square cutout texture counted: the alpha in its 2 px border, and its opaque texels (all,
+// in the lower half, and their mean grey).
+struct Opaque {
+  int border_alpha = 0;
+  long texels = 0, lower_half = 0;
+  double mean_grey = 0;
+};
+Opaque opaque_texels(const sim::Texture& t) {
+  const int w = t.width;
+  Opaque o;
+  double sum = 0;
+  for (int y = 0; y < w; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      if (x < 2 || y < 2 || x >= w - 2 || y >= w - 2) o.border_alpha += t.alpha[i];
+      if (t.alpha[i] < sim::kAlphaOpaqueFrom) continue;
+      sum += t.pixels[i], ++o.texels;
+      o.lower_half += y >= w / 2 ? 1 : 0;
+    }
+  o.mean_grey = sum / static_cast<double>(std::max(o.texels, 1L));
+  return o;
+}
+
 TEST(LeafTextures, CoverageBorderAndDilation) {
   for (LeafShape shape : {LeafShape::kBroad, LeafShape::kNarrow}) {
     const double target = shape == LeafShape::kBroad ? 0.60 : 0.50;
@@ -275,22 +298,11 @@ TEST(LeafTextures, ReedClumpCoverageBorderGreyAndSeed) {
   const double c = coverage(t);
   EXPECT_GE(c, reed_target_coverage());
   EXPECT_LE(c, reed_target_coverage() + 0.03);
-  const int w = t.width;
-  int border = 0;
-  double sum = 0;
-  long opaque = 0, lower = 0;
-  for (int y = 0; y < w; ++y)
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * w + x;
-      if (x < 2 || y < 2 || x >= w - 2 || y >= w - 2) border += t.alpha[i];
-      if (t.alpha[i] < sim::kAlphaOpaqueFrom) continue;
-      sum += t.pixels[i], ++opaque;
-      lower += y >= w / 2 ? 1 : 0;
-    }
-  EXPECT_EQ(border, 0);
-  EXPECT_NEAR(sum / static_cast<double>(opaque), 80.0, 1.0);
+  const Opaque o = opaque_texels(t);
+  EXPECT_EQ(o.border_alpha, 0);
+  EXPECT_NEAR(o.mean_grey, 80.0, 1.0);
   // Blades taper from their feet at the bottom edge: most of the cover is in the lower half.
-  EXPECT_GT(static_cast<double>(lower) / static_cast<double>(opaque), 0.6);
+  EXPECT_GT(static_cast<double>(o.lower_half) / static_cast<double>(o.texels), 0.6);
   Rng a = RngStreams(1).stream("x"), b = RngStreams(1).stream("x"), d = RngStreams(2).stream("x");
   const sim::Texture ta = make_reed_clump(&a, 90, 0.3), tb = make_reed_clump(&b, 90, 0.3),
                      td = make_reed_clump(&d, 90, 0.3);
@@ -306,19 +318,11 @@ TEST(LeafTextures, TreeBillboardCoverageBorderAndGrey) {
   const double c = coverage(t);
   EXPECT_GE(c, billboard_target_coverage());
   EXPECT_LE(c, billboard_target_coverage() + 0.03);
-  const int w = t.width;
-  int border = 0;
-  double sum = 0;
-  long opaque = 0;
-  for (int y = 0; y < w; ++y)
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * w + x;
-      if (x < 2 || y < 2 || x >= w - 2 || y >= w - 2) border += t.alpha[i];
-      if (t.alpha[i] >= sim::kAlphaOpaqueFrom) sum += t.pixels[i], ++opaque;
-    }
-  EXPECT_EQ(border, 0);
-  EXPECT_NEAR(sum / static_cast<double>(opaque), 70.0, 1.0);
+  const Opaque o = opaque_texels(t);
+  EXPECT_EQ(o.border_alpha, 0);
+  EXPECT_NEAR(o.mean_grey, 70.0, 1.0);
   // The trunk reaches the bottom: an opaque texel in the bottom rows' middle.
+  const int w = t.width;
   bool trunk = false;
   for (int x = w / 3; x < 2 * w / 3; ++x)
     trunk |= t.alpha[(w - 4) * w + x] >= sim::kAlphaOpaqueFrom;
