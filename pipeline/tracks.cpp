@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <exception>
 #include <future>
 
@@ -29,38 +30,47 @@ void add_filter_tracks(const std::vector<FusionAlgorithm>& fusion, std::size_t n
   }
 }
 
+namespace {
+
+// The VO tracks' indices, the slowest so far first (ties in track order): the order in which
+// the workers take them, so that the longest VO starts at once and the short ones fill in.
+std::vector<std::size_t> longest_first(const std::vector<Track>& tracks) {
+  std::vector<std::size_t> vos;
+  for (std::size_t i = 0; i < tracks.size(); ++i)
+    if (tracks[i].vo) vos.push_back(i);
+  std::stable_sort(vos.begin(), vos.end(),
+                   [&](std::size_t a, std::size_t b) { return tracks[a].vo_ms > tracks[b].vo_ms; });
+  return vos;
+}
+
+}  // namespace
+
 std::vector<vo::VoResult> process_vos(std::vector<Track>* tracks_io, const vo::StereoFrame& frame,
                                       int threads) {
   std::vector<Track>& tracks = *tracks_io;
   std::vector<vo::VoResult> results(tracks.size());
-  std::vector<std::size_t> vos;
-  for (std::size_t i = 0; i < tracks.size(); ++i)
-    if (tracks[i].vo) vos.push_back(i);
-  const std::size_t at_once = static_cast<std::size_t>(std::max(1, threads));
-  for (std::size_t next = 0; next < vos.size(); next += at_once) {
-    const std::size_t batch = std::min(at_once, vos.size() - next);
-    std::vector<std::future<void>> others;
-    for (std::size_t j = 1; j < batch; ++j) {
-      const std::size_t i = vos[next + j];
-      others.push_back(std::async(std::launch::async, [&tracks, &frame, &results, i] {
-        results[i] = tracks[i].vo->process(frame);
-      }));
-    }
-    std::exception_ptr error;
+  const std::vector<std::size_t> order = longest_first(tracks);
+  const std::size_t workers =
+      std::min(order.size(), static_cast<std::size_t>(std::max(1, threads)));
+  std::atomic<std::size_t> next{workers};  // worker w starts with order[w], then takes the next
+  std::atomic<bool> failed{false};
+  std::vector<std::exception_ptr> errors(workers);
+  auto work = [&](std::size_t w) {
     try {
-      results[vos[next]] = tracks[vos[next]].vo->process(frame);
+      for (std::size_t j = w; j < order.size() && (j == w || !failed); j = next++)
+        results[order[j]] = tracks[order[j]].vo->process(frame);
     } catch (...) {
-      error = std::current_exception();
+      errors[w] = std::current_exception();
+      failed = true;  // no worker takes another VO after one failed
     }
-    for (std::future<void>& f : others) {
-      try {
-        f.get();
-      } catch (...) {
-        if (!error) error = std::current_exception();
-      }
-    }
-    if (error) std::rethrow_exception(error);
-  }
+  };
+  std::vector<std::future<void>> others;
+  for (std::size_t w = 1; w < workers; ++w)
+    others.push_back(std::async(std::launch::async, work, w));
+  if (workers > 0) work(0);
+  for (std::future<void>& f : others) f.get();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
   return results;
 }
 

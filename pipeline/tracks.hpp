@@ -47,10 +47,11 @@ void add_filter_tracks(const std::vector<FusionAlgorithm>& fusion, std::size_t n
                        std::vector<Track>* tracks);
 
 /// Every VO track's result on `frame`, by track index (other tracks' entries are left
-/// default). With `threads` >= 2 the VOs run side by side, up to `threads` at a time, the
-/// calling thread one of them: a VO's result depends only on its own state and the frame, so
-/// the results are the same as in turn. A VO's exception reaches the caller after the others
-/// are done.
+/// default). With `threads` >= 2 the VOs run side by side on up to `threads` workers, the
+/// calling thread one of them, the slowest so far (`vo_ms`) first and each worker taking the
+/// next when its VO is done: a VO's result depends only on its own state and the frame, so the
+/// results are the same as in turn. After a VO throws no worker takes another; its exception
+/// reaches the caller after those running are done.
 std::vector<vo::VoResult> process_vos(std::vector<Track>* tracks, const vo::StereoFrame& frame,
                                       int threads);
 

@@ -20,12 +20,13 @@ namespace {
 // thread it ran on, and which throws on the call `throw_on` (0: never).
 class RecordingVo final : public vo::StereoOdometry {
  public:
-  RecordingVo(int id, int throw_on = 0) : id_(id), throw_on_(throw_on) {}
+  RecordingVo(int id, int throw_on = 0, int sleep_ms = 20)
+      : id_(id), throw_on_(throw_on), sleep_ms_(sleep_ms) {}
   vo::VoResult process(const vo::StereoFrame& frame) override {
     ++calls_;
     thread_ = std::this_thread::get_id();
     // Long enough for the VOs of one frame to overlap when they run side by side.
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::this_thread::sleep_for(std::chrono::milliseconds(sleep_ms_));
     if (calls_ == throw_on_) throw UserError("vo " + std::to_string(id_) + " failed");
     vo::VoResult r;
     r.valid = true;
@@ -40,7 +41,7 @@ class RecordingVo final : public vo::StereoOdometry {
   int done() const { return done_; }
 
  private:
-  int id_, throw_on_;
+  int id_, throw_on_, sleep_ms_;
   int calls_ = 0;
   std::atomic<int> done_{0};
   std::thread::id thread_;
@@ -76,7 +77,7 @@ TEST(ProcessVos, SideBySideGivesTheResultsOfTheVosInTurn) {
       EXPECT_FALSE(a[1].valid);  // the track without a VO keeps a default result
       EXPECT_EQ(a[3].inliers, 300 + static_cast<int>(t / 10));
       // In turn: every VO on the calling thread. Side by side: the three on three threads
-      // (with 2 threads, two batches: the first and third VO on the caller's thread).
+      // (with 2 threads, the third on whichever of the two is free first).
       const std::thread::id me = std::this_thread::get_id();
       for (std::size_t i : {0u, 2u, 3u}) EXPECT_EQ(vo_of(serial[i]).thread(), me);
       const std::set<std::thread::id> used{vo_of(parallel[0]).thread(), vo_of(parallel[2]).thread(),
@@ -85,6 +86,22 @@ TEST(ProcessVos, SideBySideGivesTheResultsOfTheVosInTurn) {
       EXPECT_EQ(vo_of(parallel[0]).thread(), me);
     }
   }
+}
+
+TEST(ProcessVos, TheSlowestSoFarStartsFirstAndTheOthersShareTheOtherWorker) {
+  // VO 3 took longest so far (vo_ms) and takes 200 ms now; the others 20 ms each. On two
+  // workers the caller takes VO 3 first and the other worker runs VOs 1 and 2 one after the
+  // other meanwhile (in track order: the calls of the VOs in turn took 0 ms so far).
+  std::vector<Track> tracks(3);
+  tracks[0].vo = std::make_unique<RecordingVo>(1);
+  tracks[1].vo = std::make_unique<RecordingVo>(2);
+  tracks[2].vo = std::make_unique<RecordingVo>(3, 0, 200);
+  tracks[2].vo_ms = 100;
+  const auto results = process_vos(&tracks, vo::StereoFrame{}, 2);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(results[i].inliers, 100 * (i + 1) + 1) << i;
+  EXPECT_EQ(vo_of(tracks[2]).thread(), std::this_thread::get_id());
+  EXPECT_NE(vo_of(tracks[0]).thread(), std::this_thread::get_id());
+  EXPECT_EQ(vo_of(tracks[0]).thread(), vo_of(tracks[1]).thread());
 }
 
 TEST(ProcessVos, AVosExceptionReachesTheCallerAfterTheOthersFinish) {
