@@ -84,15 +84,15 @@ struct RiverReachOptions {
   double tree_height_m = 12.0;
   double vegetation_density = 0.6;
   TreeModel tree_model = TreeModel::kSkeleton;
-  int leaf_cards_per_tree = 60;
-  ReedModel reed_model = ReedModel::kBlades;
-  double waterline_stones_per_m = 0;
-  double far_trees_per_m = 0;
+  int leaf_cards_per_tree = 45;
+  ReedModel reed_model = ReedModel::kCards;
+  double waterline_stones_per_m = 1.5;
+  double far_trees_per_m = 0.1;
   double tree_detail_distance_m = 7.0;
   double texture_contrast = 2.0;
   bool photographs = true;
   double cloud_contrast = 0.08;
-  std::optional<double> visibility_m;  // null: the sky's own haze (outdoor_lighting)
+  std::optional<double> visibility_m = 9000.0;  // null: the sky's own haze (outdoor_lighting)
   bool bridge = true;
   bool quay_wall = true;
   int buildings = 4;
@@ -190,9 +190,9 @@ struct RiverReachOptions {
     a("visibility_m", visibility_m,
       "Meteorological visibility of the haze over the river [m]: a surface d metres away keeps "
       "exp(-3.912 d / visibility_m) of its contrast against the horizon's grey (Koschmieder's "
-      "law, a 2 % contrast threshold). null: the sky's own haze, 1.56 km under overcast and "
-      "3.13 km under sun (extinction lengths of 400 and 800 m); the river paper's survey day "
-      "had 9 km. The cloud deck keeps its own fading. A misty morning: "
+      "law, a 2 % contrast threshold); 9 km by default, the river paper's survey day. null: "
+      "the sky's own haze, 1.56 km under overcast and 3.13 km under sun (extinction lengths of "
+      "400 and 800 m). The cloud deck keeps its own fading. A misty morning: "
       "scenarios/river_crossing_mist.yaml",
       yaml::at_least(10) & yaml::up_to(3e5, "clearer than the clearest air (about 300 km)"));
     a("bridge", bridge, "Road bridge with piers across each reach tile");

@@ -428,7 +428,8 @@ TEST(RiverReach, WaterEdgeAtTheConfiguredBankDistance) {
     for (const auto& m : g.meshes) {
       const bool may_overhang = name_has(m, "bridge") || name_has(m, "quay") ||
                                 name_has(m, "reeds") || name_has(m, "tree_") ||
-                                name_has(m, "bushes") || name_has(m, "river_bend");
+                                name_has(m, "bushes") || name_has(m, "river_bend") ||
+                                name_has(m, "stones");  // sunk into the bed at the edge
       const bool terrain = name_has(m, "bank_") || name_has(m, "plain_");
       for (const auto& v : m.vertices) {
         // Trees may lean over the water, but keep the boats' part of it clear.
@@ -606,9 +607,11 @@ TEST(RiverReach, FeatureDepthsLikeRiverPaperTable4) {
   EXPECT_GE(c.p10, 4.0);
   EXPECT_LE(c.p10, 15.0);
   EXPECT_GE(c.p90, 30.0);
-  // 60: rays through the skeleton trees' crowns reach the wood beyond (62 m and more): p90
-  // 57.4 m (was 41 under the ellipsoid crowns).
-  EXPECT_LE(c.p90, 60.0);
+  // 75: rays through the skeleton trees' crowns reach the wood beyond (62 m and more): p90
+  // 57.4 m (was 41 under the ellipsoid crowns); the far trees (62-87 m) catch rays that went
+  // to the sky before (1,030 sky rays -> 896) and 45 leaf cards a near tree let more through
+  // to the wood: p90 68.1 m, the median 22.8 -> 23.9 m.
+  EXPECT_LE(c.p90, 75.0);
   // Off-centre (the crossings of the river_crossing scenario run to 3.25 m
   // from the banks) the near end reaches the paper's ~4 m.
   const DepthStats off = feature_depths(rc, {{0, 6, -0.5}, {30, -6, -0.5}}, headings);
@@ -645,14 +648,17 @@ TEST(RiverReach, SkyPicksTheLighting) {
 
 // scene.river_reach.visibility_m: the haze's extinction length is the visibility over
 // -ln(0.02) = 3.912 (Koschmieder's law: at the visibility 2 % of a contrast is left, as the
-// renderer's exp(-d / fog_distance_m) gives); null keeps the sky's own haze.
+// renderer's exp(-d / fog_distance_m) gives); 9 km by default (the river paper's survey day);
+// null keeps the sky's own haze.
 TEST(RiverReach, VisibilitySetsTheHazeByKoschmiedersLaw) {
   RiverReachOptions o = river_defaults();
+  EXPECT_EQ(o.visibility_m, 9000.0);
+  o.visibility_m = std::nullopt;
   for (const Sky sky : {Sky::kOvercast, Sky::kSun})
     EXPECT_EQ(build_river_reach(o, sky, kSeed, 0, 10).lighting.fog_distance_m,
               outdoor_lighting(sky).fog_distance_m);
   EXPECT_EQ(outdoor_lighting(Sky::kOvercast).fog_distance_m, 400.f);
-  o.visibility_m = 9000;  // the river paper's survey day
+  o.visibility_m = 9000;
   const float fog = build_river_reach(o, Sky::kOvercast, kSeed, 0, 10).lighting.fog_distance_m;
   EXPECT_NEAR(fog, 9000 / 3.912, 0.01);
   EXPECT_NEAR(std::exp(-9000 / fog), 0.02, 1e-4);
@@ -713,12 +719,15 @@ TEST(RiverReach, VegetationSwaysAndTheRestIsRigid) {
 // (alpha), feet in the bank and tops above the water, as many clumps as the blades' within the
 // quay's and bridge's gaps (6 triangles a clump against 28; the clumps' places are drawn from
 // the same stream, which the blades advance further), bending from the foot as the blades do.
+// Cards by default.
 TEST(RiverReach, ReedCardsAreThreeCrossedUprightCardsAClump) {
   RiverReachOptions o = river_defaults();
-  o.reed_model = ReedModel::kCards;
-  const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
-  const sim::Mesh* cards = find_mesh(g, "tile0.reeds");
-  const sim::Mesh* blades = find_mesh(default_reach(), "tile0.reeds");
+  EXPECT_EQ(o.reed_model, ReedModel::kCards);
+  o.reed_model = ReedModel::kBlades;
+  const auto blade_scene = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
+  const sim::Mesh* cards = find_mesh(default_reach(), "tile0.reeds");
+  const sim::Mesh* blades = find_mesh(blade_scene, "tile0.reeds");
+  const sim::SceneGeometry& g = default_reach();
   ASSERT_TRUE(cards && blades);
   ASSERT_GE(cards->material.texture, 0);
   const sim::Texture& t = g.textures[static_cast<std::size_t>(cards->material.texture)];
@@ -747,16 +756,19 @@ TEST(RiverReach, ReedCardsAreThreeCrossedUprightCardsAClump) {
     EXPECT_GE(foot.z - top.z, 1.2f - 1e-4f);
     EXPECT_LE(foot.z - top.z, 3.0f);
   }
-  // The default scene does not carry the clump texture.
-  for (const sim::Texture& d : default_reach().textures) EXPECT_NE(d.name, "reeds_clump");
+  // The blades' scene does not carry the clump texture.
+  for (const sim::Texture& d : blade_scene.textures) EXPECT_NE(d.name, "reeds_clump");
 }
 
 // waterline_stones_per_m: that many stones a metre of bank on each side (less the quay's and
 // the bridge's gaps), each a faceted lump within 0.43 m of its centre near the water's edge;
-// none by default.
+// 1.5 by default; none at 0.
 TEST(RiverReach, WaterlineStonesLieAtTheWatersEdge) {
-  EXPECT_FALSE(find_mesh(default_reach(), "tile0.stones"));
+  EXPECT_TRUE(find_mesh(default_reach(), "tile0.stones"));
   RiverReachOptions o = river_defaults();
+  EXPECT_EQ(o.waterline_stones_per_m, 1.5);
+  o.waterline_stones_per_m = 0;
+  EXPECT_FALSE(find_mesh(build_river_reach(o, Sky::kOvercast, kSeed, 0, 120), "tile0.stones"));
   o.waterline_stones_per_m = 1.0;
   const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
   const sim::Mesh* stones = find_mesh(g, "tile0.stones");
@@ -793,10 +805,14 @@ TEST(RiverReach, WaterlineStonesLieAtTheWatersEdge) {
 
 // far_trees_per_m: on each side that many trees a metre, each two upright cards at right angles
 // (world-fixed crossed billboards) 10-16 m tall and 0.7 of that wide in the billboard texture;
-// none by default.
+// 0.1 by default; none at 0.
 TEST(RiverReach, FarTreesAreCrossedUprightBillboards) {
-  EXPECT_FALSE(find_mesh(default_reach(), "tile0.far_trees_east"));
+  EXPECT_TRUE(find_mesh(default_reach(), "tile0.far_trees_east"));
   RiverReachOptions o = river_defaults();
+  EXPECT_EQ(o.far_trees_per_m, 0.1);
+  o.far_trees_per_m = 0;
+  EXPECT_FALSE(
+      find_mesh(build_river_reach(o, Sky::kOvercast, kSeed, 0, 120), "tile0.far_trees_east"));
   o.far_trees_per_m = 0.25;
   const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
   for (const char* name : {"tile0.far_trees_east", "tile0.far_trees_west"}) {
