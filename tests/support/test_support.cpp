@@ -8,6 +8,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 
 namespace driftlab::test {
@@ -34,10 +35,40 @@ std::vector<std::string> expected_messages(const fs::path& file) {
   return out;
 }
 
+namespace {
+
+// The temporary paths this process handed out, removed when it exits (never by a forked
+// child), so that the tests leave nothing behind in the temporary folder.
+class TempPaths {
+ public:
+  void add(const fs::path& p) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    paths_.push_back(p);
+  }
+  ~TempPaths() {
+    if (::getpid() != owner_) return;
+    std::error_code ignored;
+    for (const fs::path& p : paths_) fs::remove_all(p, ignored);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<fs::path> paths_;
+  const pid_t owner_ = ::getpid();
+};
+
+TempPaths& temp_paths() {
+  static TempPaths paths;
+  return paths;
+}
+
+}  // namespace
+
 fs::path unused_temp_path(const std::string& name) {
   const fs::path p =
       fs::temp_directory_path() / ("driftlab_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(p);
+  temp_paths().add(p);
   return p;
 }
 

@@ -44,7 +44,8 @@ std::string user_error_of(const std::function<void()>& f);
 /// Expects `f` to throw a UserError whose message contains `part`.
 void expect_user_error(const std::function<void()>& f, const std::string& part);
 
-/// A path under the temporary folder, unique to this process and `name`, that does not exist.
+/// A path under the temporary folder, unique to this process and `name`, that does not exist;
+/// removed, with what is under it, when the process exits.
 std::filesystem::path unused_temp_path(const std::string& name);
 /// The same path, created as an empty folder.
 std::filesystem::path fresh_temp_dir(const std::string& name);
