@@ -354,28 +354,60 @@ void add_bridge(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k, 
 
 // ---------------------------------------------------------------------------
 // The quay: corrugated steel sheet piling along the east bank, a concrete
-// capping beam and a paved quay behind.
+// capping beam and a paved quay behind; optionally a wet band on the piling
+// (quay_stain_height_m) and steel ladders on its face (quay_ladder_spacing_m).
 
-void add_quay(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k, const Textures& tex) {
+// Ladders on the quay's face (east bank, facing -y), centred at each x of `xs`: two rails
+// from 1 m below the water to handholds 0.9 m above the capping beam at z_cap_top, rungs every
+// 0.3 m, standing off the beam's face (b - 0.15) by 0.1 m.
+void add_quay_ladders(sim::SceneGeometry* g, const RiverTileLayout& L, double b, double z_cap_top,
+                      const std::vector<double>& xs) {
+  if (xs.empty()) return;
+  MeshBuilder ladders(tile_name(L.index, "quay_ladders"), material(-1, 0.45f, 0.2f));
+  const double y = b - 0.25, z_bottom = 1.0, z_top = z_cap_top - 0.9;
+  for (const double x : xs) {
+    for (const double dx : {-0.225, 0.225})
+      ladders.prism({x + dx, y, z_top}, {x + dx, y, z_bottom}, 0.025, 6, 0.2);
+    for (double z = 0.7; z > z_cap_top; z -= 0.3)
+      ladders.prism({x - 0.225, y, z}, {x + 0.225, y, z}, 0.015, 4, 0.1);
+  }
+  add_mesh(g, ladders.take());
+}
+
+void add_quay(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k, const Textures& tex,
+              const RiverReachOptions& o) {
   MeshBuilder pile(tile_name(L.index, "quay_piling"), material(tex.sheet, 0.55f, 0.15f));
+  MeshBuilder wet(tile_name(L.index, "quay_piling_wet"), material(tex.sheet, 0.55f * 0.55f, 0.25f));
   MeshBuilder cap(tile_name(L.index, "quay_cap"), material(tex.concrete, 0.8f));
   MeshBuilder paving(tile_name(L.index, "quay_paving"), material(tex.stone, 0.7f));
   const double b = k.b, z_pile_top = -(k.H + 0.4), z_foot = 1.0;
   const double z_cap_top = z_pile_top - 0.5;
+  // The wet band's top (NED: up is -z), never above the piling.
+  const double z_stain = -std::min(o.quay_stain_height_m, -z_pile_top);
   // Larssen-type profile per 1.2 m pitch: outer pan, web, inner pan, web.
   static constexpr double kPx[5] = {0.0, 0.35, 0.6, 0.95, 1.2};
   static constexpr double kPy[5] = {0.0, 0.0, 0.22, 0.22, 0.0};
   const double pitch = 1.2;
   const int pitches = static_cast<int>(std::floor((L.quay_x1_m - L.quay_x0_m) / pitch));
+  // One facet of the piling from z_a down to z_b; texture anchored to the world (u = x / 2.4 m)
+  // so pans line up across facets.
+  const auto facet = [&](MeshBuilder* mb, double xa, double xb, double ya, double yb, double z_a,
+                         double z_b) {
+    const Eigen::Vector2d t0(xa / 2.4, z_a / 2.0), t1(xb / 2.4, z_a / 2.0);
+    const Eigen::Vector2d t2(xb / 2.4, z_b / 2.0), t3(xa / 2.4, z_b / 2.0);
+    mb->quad({xa, ya, z_a}, {xb, yb, z_a}, {xb, yb, z_b}, {xa, ya, z_b}, -Vec3::UnitY(), t0, t1, t2,
+             t3);
+  };
   for (int p = 0; p < pitches; ++p)
     for (int s = 0; s < 4; ++s) {
       const double xa = L.quay_x0_m + p * pitch + kPx[s], xb = L.quay_x0_m + p * pitch + kPx[s + 1];
       const double ya = b + kPy[s], yb = b + kPy[s + 1];
-      // Texture anchored to the world (u = x / 2.4 m) so pans line up across facets.
-      const Eigen::Vector2d t0(xa / 2.4, z_pile_top / 2.0), t1(xb / 2.4, z_pile_top / 2.0);
-      const Eigen::Vector2d t2(xb / 2.4, z_foot / 2.0), t3(xa / 2.4, z_foot / 2.0);
-      pile.quad({xa, ya, z_pile_top}, {xb, yb, z_pile_top}, {xb, yb, z_foot}, {xa, ya, z_foot},
-                -Vec3::UnitY(), t0, t1, t2, t3);
+      if (z_stain < 0) {
+        facet(&pile, xa, xb, ya, yb, z_pile_top, z_stain);
+        facet(&wet, xa, xb, ya, yb, z_stain, z_foot);
+      } else {
+        facet(&pile, xa, xb, ya, yb, z_pile_top, z_foot);
+      }
     }
   const double x0 = L.quay_x0_m, x1 = L.quay_x0_m + pitches * pitch;
   // End plates close the gap between the piles and the paving at both ends.
@@ -386,8 +418,14 @@ void add_quay(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k, co
   paving.box({x0, b + 0.7, z_cap_top}, {x1, b + kQuayPaving_m, 0.3}, 3.0,
              MeshBuilder::kNoBottom & ~MeshBuilder::kWest);
   add_mesh(g, pile.take());
+  if (z_stain < 0) add_mesh(g, wet.take());
   add_mesh(g, cap.take());
   add_mesh(g, paving.take());
+  std::vector<double> ladder_x;
+  if (o.quay_ladder_spacing_m > 0)
+    for (double x = x0 + o.quay_ladder_spacing_m / 2; x < x1 - 0.5; x += o.quay_ladder_spacing_m)
+      ladder_x.push_back(x);
+  add_quay_ladders(g, L, b, z_cap_top, ladder_x);
 }
 
 // ---------------------------------------------------------------------------
@@ -1034,7 +1072,7 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
     add_waterline_stones(&g, L, k, n, tex, options, seed, index);
 
     if (L.bridge) add_bridge(&g, L, k, n, tex);
-    if (L.quay) add_quay(&g, L, k, tex);
+    if (L.quay) add_quay(&g, L, k, tex, options);
     add_buildings(&g, L, tex);
     for (int side : {1, -1}) {
       add_far_field(&g, L, k, n, tex, side);

@@ -95,6 +95,8 @@ struct RiverReachOptions {
   std::optional<double> visibility_m = 9000.0;  // null: the sky's own haze (outdoor_lighting)
   bool bridge = true;
   bool quay_wall = true;
+  double quay_ladder_spacing_m = 0;
+  double quay_stain_height_m = 0;
   int buildings = 4;
   double view_margin_m = 150.0;
   std::vector<OtherVesselOptions> vessels;
@@ -198,6 +200,16 @@ struct RiverReachOptions {
     a("bridge", bridge, "Road bridge with piers across each reach tile");
     a("quay_wall", quay_wall,
       "Feature-poor sheet-piled quay wall (~30 m) on the east bank of each tile");
+    a("quay_ladder_spacing_m", quay_ladder_spacing_m,
+      "Steel ladders on the quay wall's face, one every this many metres along it (the first "
+      "half a spacing from its south end; each two 50 mm rails 0.45 m apart with 30 mm rungs "
+      "every 0.3 m, from 1 m below the water to handholds 0.9 m above the capping beam); 0: "
+      "none",
+      yaml::non_negative() & yaml::up_to(1000, "no quay is longer"));
+    a("quay_stain_height_m", quay_stain_height_m,
+      "A dark wet band of algae and rust on the quay wall's piling from the water up to this "
+      "height [m] (the piling's grain at 0.55 of its albedo); 0: none",
+      yaml::non_negative() & yaml::up_to(3, "the piling stands about 1.9 m above the water"));
     a("buildings", buildings, "Number of buildings behind the banks, per reach tile",
       yaml::in_range(0, 100));
     a("view_margin_m", view_margin_m,

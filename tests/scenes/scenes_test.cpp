@@ -553,6 +553,56 @@ TEST(RiverReach, BridgeAndQuayFollowTheirOptions) {
   EXPECT_TRUE(find_mesh(without, "tile0.bollards"));
 }
 
+// quay_ladder_spacing_m: ladders on the piling's face every that many metres, the first half a
+// spacing from the quay's south end, each two rails 0.45 m apart from 1 m below the water to
+// 0.9 m above the capping beam; quay_stain_height_m: the piling from the water up to that height
+// a separate, darker mesh. Neither by default (the same piling as before).
+TEST(RiverReach, QuayLaddersAndWetBandFollowTheirOptions) {
+  EXPECT_FALSE(find_mesh(default_reach(), "tile0.quay_ladders"));
+  EXPECT_FALSE(find_mesh(default_reach(), "tile0.quay_piling_wet"));
+  RiverReachOptions o = river_defaults();
+  o.quay_ladder_spacing_m = 10;
+  o.quay_stain_height_m = 0.6;
+  const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
+  const RiverTileLayout L = plan_river_tile(o, kSeed, 0);
+  ASSERT_TRUE(L.quay);
+  const sim::Mesh* ladders = find_mesh(g, "tile0.quay_ladders");
+  const sim::Mesh* wet = find_mesh(g, "tile0.quay_piling_wet");
+  const sim::Mesh* dry = find_mesh(g, "tile0.quay_piling");
+  ASSERT_TRUE(ladders && wet && dry);
+  EXPECT_LT(wet->material.albedo, dry->material.albedo);
+  for (const sim::Vertex& v : wet->vertices) {
+    EXPECT_GE(v.z, -0.6f - 1e-5f);
+    EXPECT_LE(v.z, 1.0f + 1e-5f);
+  }
+  const double b = o.bank_distance_m, z_cap_top = -(o.bank_height_m + 0.9);
+  // Rails and rungs within 3 cm of the plane 0.25 m off the piling, from z 1 up to the handholds.
+  float z_min = 1e9f, z_max = -1e9f;
+  for (const sim::Vertex& v : ladders->vertices) {
+    EXPECT_NEAR(v.y, b - 0.25, 0.026);
+    z_min = std::min(z_min, v.z);
+    z_max = std::max(z_max, v.z);
+  }
+  EXPECT_NEAR(z_min, z_cap_top - 0.9, 0.03);
+  EXPECT_NEAR(z_max, 1.0, 0.03);
+  // 30 m of quay: ladders at 5, 15 and 25 m from its south end, found by rays from mid-river
+  // towards the bank 0.225 m either side of each centre, just above the water.
+  RayCaster rc(g);
+  std::string what;
+  for (double along : {5.0, 15.0, 25.0})
+    for (double dx : {-0.225, 0.225}) {
+      const double d = rc.cast({L.quay_x0_m + along + dx, 0, -0.1}, {0, 1, 0}, &what);
+      EXPECT_EQ(what, "tile0.quay_ladders") << along << " " << dx;
+      EXPECT_NEAR(d, b - 0.25 - 0.025, 0.01) << along << " " << dx;
+    }
+  // Between ladders the piling: wet below 0.6 m above the water, dry above it.
+  const double between = L.quay_x0_m + 10.05;
+  rc.cast({between, 0, -0.3}, {0, 1, 0}, &what);
+  EXPECT_EQ(what, "tile0.quay_piling_wet");
+  rc.cast({between, 0, -0.9}, {0, 1, 0}, &what);
+  EXPECT_EQ(what, "tile0.quay_piling");
+}
+
 TEST(RiverReach, BuildingsPerOption) {
   RiverReachOptions o = river_defaults();
   for (int n : {0, 1, 4, 7}) {
