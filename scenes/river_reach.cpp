@@ -860,6 +860,38 @@ void add_waterline_stones(sim::SceneGeometry* g, const RiverTileLayout& L, const
   add_mesh(g, stones.take());
 }
 
+// Roots laid bare by the current (bank_roots_per_tree) in front of each tree within 6 m of the
+// water's edge: a tube of bark from a point on the bank slope, arching up to 15 cm out of it,
+// to the toe just under the water, 5 cm thick at the slope and 1 cm at its end.
+void add_bank_roots(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k, const Noise& n,
+                    const Textures& tex, const RiverReachOptions& options, std::uint64_t seed) {
+  if (options.bank_roots_per_tree <= 0) return;
+  MeshBuilder roots(tile_name(L.index, "bank_roots"), solid(tex.bark, 0.7f));
+  Rng rr = RngStreams(seed).stream("scene.river.tile." + std::to_string(L.index) + ".roots");
+  constexpr int kPoints = 6;
+  for (const TreeSpec& t : L.trees) {
+    const int side = t.base_W.y() > 0 ? 1 : -1;
+    if (std::abs(t.base_W.y()) - k.b > 6.0) continue;
+    for (int j = 0; j < options.bank_roots_per_tree; ++j) {
+      const double x = t.base_W.x() + rr.uniform(-1.5, 1.5);
+      const double s0 = rr.uniform(0.25, 0.9) * k.run, s1 = rr.uniform(-0.2, 0.0);
+      const double bulge = rr.uniform(0.05, 0.15), drift = rr.uniform(-0.4, 0.4);
+      std::vector<Vec3> points;
+      std::vector<double> radii;
+      for (int i = 0; i < kPoints; ++i) {
+        const double u = static_cast<double>(i) / (kPoints - 1);
+        const double s = s0 + (s1 - s0) * u, xi = x + drift * u;
+        // Out of the slope (NED: up is -z) along the arch, back into the toe at its end.
+        const double lift = bulge * std::sin(kPi * std::min(1.0, 1.25 * u));
+        points.emplace_back(xi, side * (k.b + s), terrain_z(k, n, xi, s, side) - lift);
+        radii.push_back(0.05 - 0.04 * u);
+      }
+      roots.tube(points, radii, 5, 0.3);
+    }
+  }
+  add_mesh(g, roots.take());
+}
+
 // Bushes (willow scrub) on the bank between the reeds and the tree line,
 // drawn after the trees so that they do not move them.
 std::vector<TreeSpec> plan_bushes(const RiverReachOptions& o, const Bank& k, const Noise& n,
@@ -1070,6 +1102,7 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
 
     add_reeds(&g, L, k, n, tex, options, seed, index);
     add_waterline_stones(&g, L, k, n, tex, options, seed, index);
+    add_bank_roots(&g, L, k, n, tex, options, seed);
 
     if (L.bridge) add_bridge(&g, L, k, n, tex);
     if (L.quay) add_quay(&g, L, k, tex, options);

@@ -88,6 +88,7 @@ struct RiverReachOptions {
   ReedModel reed_model = ReedModel::kCards;
   double waterline_stones_per_m = 1.5;
   double far_trees_per_m = 0.1;
+  int bank_roots_per_tree = 0;
   double tree_detail_distance_m = 7.0;
   double texture_contrast = 2.0;
   bool photographs = true;
@@ -168,6 +169,11 @@ struct RiverReachOptions {
       "Far trees per metre of the far wood on each side: world-fixed crossed billboards, 10-16 m "
       "tall, growing out of the wood's canopy within 25 m of its front; 0: none",
       yaml::in_range(0, 2));
+    a("bank_roots_per_tree", bank_roots_per_tree,
+      "Roots laid bare by the current where a tree stands within 6 m of the water's edge: each "
+      "a tapering tube of bark (5 to 1 cm) out of the bank slope, arching out over the toe and "
+      "into the water within 1.5 m of the trunk's line; 0: none",
+      yaml::in_range(0, 12));
     a("tree_detail_distance_m", tree_detail_distance_m,
       "Trees at most this far behind the water's edge get twigs and the full set of cards; "
       "those further back three-sided limbs and half the cards (skeleton trees only)",

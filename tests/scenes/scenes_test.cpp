@@ -429,7 +429,8 @@ TEST(RiverReach, WaterEdgeAtTheConfiguredBankDistance) {
       const bool may_overhang = name_has(m, "bridge") || name_has(m, "quay") ||
                                 name_has(m, "reeds") || name_has(m, "tree_") ||
                                 name_has(m, "bushes") || name_has(m, "river_bend") ||
-                                name_has(m, "stones");  // sunk into the bed at the edge
+                                name_has(m, "stones") ||  // sunk into the bed at the edge
+                                name_has(m, "roots");     // arching out over the toe
       const bool terrain = name_has(m, "bank_") || name_has(m, "plain_");
       for (const auto& v : m.vertices) {
         // Trees may lean over the water, but keep the boats' part of it clear.
@@ -808,6 +809,44 @@ TEST(RiverReach, ReedCardsAreThreeCrossedUprightCardsAClump) {
   }
   // The blades' scene does not carry the clump texture.
   for (const sim::Texture& d : blade_scene.textures) EXPECT_NE(d.name, "reeds_clump");
+}
+
+// bank_roots_per_tree: that many tubes of bark in front of each tree within 6 m of the water's
+// edge, each from the bank slope (a quarter to 0.9 of its run up) arching at most 15 cm out of
+// the ground to the toe just under the water; none by default.
+TEST(RiverReach, BankRootsRunFromTheSlopeIntoTheWater) {
+  EXPECT_FALSE(find_mesh(default_reach(), "tile0.bank_roots"));
+  RiverReachOptions o = river_defaults();
+  o.bank_roots_per_tree = 4;
+  const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
+  const sim::Mesh* roots = find_mesh(g, "tile0.bank_roots");
+  ASSERT_TRUE(roots);
+  const RiverTileLayout L = plan_river_tile(o, kSeed, 0);
+  std::size_t near_trees = 0;
+  for (const TreeSpec& t : L.trees) near_trees += std::abs(t.base_W.y()) - o.bank_distance_m <= 6.0;
+  ASSERT_GT(near_trees, 0u);
+  const std::size_t n = near_trees * 4;
+  // A tube of 6 points and 5 sides: 5 segments of 10 triangles.
+  ASSERT_EQ(roots->indices.size(), n * 5 * 10 * 3);
+  ASSERT_EQ(roots->vertices.size() % n, 0u);
+  const std::size_t per_root = roots->vertices.size() / n;
+  const double b = o.bank_distance_m;
+  const double run = o.bank_height_m / std::tan(o.bank_slope_deg * std::numbers::pi / 180.0);
+  for (std::size_t r = 0; r < n; ++r) {
+    double y_in = 1e9, y_out = 0;
+    for (std::size_t i = r * per_root; i < (r + 1) * per_root; ++i) {
+      const sim::Vertex& v = roots->vertices[i];
+      const double s = std::abs(v.y) - b;
+      y_in = std::min(y_in, s);
+      y_out = std::max(y_out, s);
+      // Never more than the arch and the root's thickness out of the ground.
+      EXPECT_GE(v.z, river_terrain_z(o, kSeed, v.x, v.y) - 0.15 - 0.05 - 0.02) << r;
+    }
+    EXPECT_GE(y_out, 0.25 * run - 0.06) << r;  // from the slope
+    EXPECT_LE(y_out, 0.9 * run + 0.06) << r;
+    EXPECT_LE(y_in, 0.01) << r;  // into the water
+    EXPECT_GE(y_in, -0.2 - 0.03) << r;
+  }
 }
 
 // waterline_stones_per_m: that many stones a metre of bank on each side (less the quay's and
