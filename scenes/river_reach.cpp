@@ -861,11 +861,13 @@ void add_waterline_stones(sim::SceneGeometry* g, const RiverTileLayout& L, const
 }
 
 // Roots laid bare by the current (bank_roots_per_tree) in front of each tree within 6 m of the
-// water's edge: a tube of bark from a point on the bank slope, arching up to 15 cm out of it,
-// to the toe just under the water, 5 cm thick at the slope and 1 cm at its end.
+// water's edge: a tube of bark from a point on the bank slope (at most 3 m up it), arching up
+// to 15 cm out of it, to the toe just under the water, 5 cm thick at the slope and 1 cm at its
+// end. None on a bank whose slope runs less than 0.5 m (vertical, or no bank): there the arch
+// would bend tighter than the root is thick and fold its tube inside out.
 void add_bank_roots(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k, const Noise& n,
                     const Textures& tex, const RiverReachOptions& options, std::uint64_t seed) {
-  if (options.bank_roots_per_tree <= 0) return;
+  if (options.bank_roots_per_tree <= 0 || k.run < 0.5) return;
   MeshBuilder roots(tile_name(L.index, "bank_roots"), solid(tex.bark, 0.7f));
   Rng rr = RngStreams(seed).stream("scene.river.tile." + std::to_string(L.index) + ".roots");
   constexpr int kPoints = 6;
@@ -874,7 +876,7 @@ void add_bank_roots(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank&
     if (std::abs(t.base_W.y()) - k.b > 6.0) continue;
     for (int j = 0; j < options.bank_roots_per_tree; ++j) {
       const double x = t.base_W.x() + rr.uniform(-1.5, 1.5);
-      const double s0 = rr.uniform(0.25, 0.9) * k.run, s1 = rr.uniform(-0.2, 0.0);
+      const double s0 = std::min(rr.uniform(0.25, 0.9) * k.run, 3.0), s1 = rr.uniform(-0.2, 0.0);
       const double bulge = rr.uniform(0.05, 0.15), drift = rr.uniform(-0.4, 0.4);
       std::vector<Vec3> points;
       std::vector<double> radii;

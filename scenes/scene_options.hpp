@@ -88,7 +88,7 @@ struct RiverReachOptions {
   ReedModel reed_model = ReedModel::kCards;
   double waterline_stones_per_m = 1.5;
   double far_trees_per_m = 0.1;
-  int bank_roots_per_tree = 0;
+  int bank_roots_per_tree = 4;
   double tree_detail_distance_m = 7.0;
   double texture_contrast = 2.0;
   bool photographs = true;
@@ -96,8 +96,8 @@ struct RiverReachOptions {
   std::optional<double> visibility_m = 9000.0;  // null: the sky's own haze (outdoor_lighting)
   bool bridge = true;
   bool quay_wall = true;
-  double quay_ladder_spacing_m = 0;
-  double quay_stain_height_m = 0;
+  double quay_ladder_spacing_m = 15;
+  double quay_stain_height_m = 0.5;
   int buildings = 4;
   double view_margin_m = 150.0;
   std::vector<OtherVesselOptions> vessels;
@@ -171,8 +171,9 @@ struct RiverReachOptions {
       yaml::in_range(0, 2));
     a("bank_roots_per_tree", bank_roots_per_tree,
       "Roots laid bare by the current where a tree stands within 6 m of the water's edge: each "
-      "a tapering tube of bark (5 to 1 cm) out of the bank slope, arching out over the toe and "
-      "into the water within 1.5 m of the trunk's line; 0: none",
+      "a tapering tube of bark (5 to 1 cm) out of the bank slope (at most 3 m up it), arching "
+      "out over the toe and into the water within 1.5 m of the trunk's line; none where the "
+      "slope runs less than 0.5 m (a vertical bank, or none); 0: none",
       yaml::in_range(0, 12));
     a("tree_detail_distance_m", tree_detail_distance_m,
       "Trees at most this far behind the water's edge get twigs and the full set of cards; "

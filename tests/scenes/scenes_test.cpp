@@ -557,11 +557,19 @@ TEST(RiverReach, BridgeAndQuayFollowTheirOptions) {
 // quay_ladder_spacing_m: ladders on the piling's face every that many metres, the first half a
 // spacing from the quay's south end, each two rails 0.45 m apart from 1 m below the water to
 // 0.9 m above the capping beam; quay_stain_height_m: the piling from the water up to that height
-// a separate, darker mesh. Neither by default (the same piling as before).
+// a separate, darker mesh. By default a ladder every 15 m and a 0.5 m band; at 0 neither (one
+// piling mesh).
 TEST(RiverReach, QuayLaddersAndWetBandFollowTheirOptions) {
-  EXPECT_FALSE(find_mesh(default_reach(), "tile0.quay_ladders"));
-  EXPECT_FALSE(find_mesh(default_reach(), "tile0.quay_piling_wet"));
+  EXPECT_TRUE(find_mesh(default_reach(), "tile0.quay_ladders"));
+  EXPECT_TRUE(find_mesh(default_reach(), "tile0.quay_piling_wet"));
   RiverReachOptions o = river_defaults();
+  EXPECT_EQ(o.quay_ladder_spacing_m, 15);
+  EXPECT_EQ(o.quay_stain_height_m, 0.5);
+  o.quay_ladder_spacing_m = 0;
+  o.quay_stain_height_m = 0;
+  const auto bare = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
+  EXPECT_FALSE(find_mesh(bare, "tile0.quay_ladders"));
+  EXPECT_FALSE(find_mesh(bare, "tile0.quay_piling_wet"));
   o.quay_ladder_spacing_m = 10;
   o.quay_stain_height_m = 0.6;
   const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
@@ -813,10 +821,12 @@ TEST(RiverReach, ReedCardsAreThreeCrossedUprightCardsAClump) {
 
 // bank_roots_per_tree: that many tubes of bark in front of each tree within 6 m of the water's
 // edge, each from the bank slope (a quarter to 0.9 of its run up) arching at most 15 cm out of
-// the ground to the toe just under the water; none by default.
+// the ground to the toe just under the water; 4 by default, none at 0.
 TEST(RiverReach, BankRootsRunFromTheSlopeIntoTheWater) {
-  EXPECT_FALSE(find_mesh(default_reach(), "tile0.bank_roots"));
   RiverReachOptions o = river_defaults();
+  EXPECT_EQ(o.bank_roots_per_tree, 4);
+  o.bank_roots_per_tree = 0;
+  EXPECT_FALSE(find_mesh(build_river_reach(o, Sky::kOvercast, kSeed, 0, 120), "tile0.bank_roots"));
   o.bank_roots_per_tree = 4;
   const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
   const sim::Mesh* roots = find_mesh(g, "tile0.bank_roots");
