@@ -894,6 +894,94 @@ void add_bank_roots(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank&
   add_mesh(g, roots.take());
 }
 
+// Stretches [x0, x1) of one bank undercut by the current (bank_undercut_share): 3-10 m long,
+// the gaps between them drawn (uniform, mean len (1 - share) / share) so that the share asked
+// for is undercut on average; clipped out of the quay (east bank) and the bridge, pieces
+// under a metre dropped.
+std::vector<std::pair<double, double>> plan_undercuts(const RiverTileLayout& L, double share,
+                                                      int side, Rng* rng) {
+  std::vector<std::pair<double, double>> keep_out;
+  if (L.quay && side > 0) keep_out.emplace_back(L.quay_x0_m - 1.0, L.quay_x1_m + 1.0);
+  if (L.bridge)
+    keep_out.emplace_back(L.bridge_x_m - L.bridge_half_width_m - 1.0,
+                          L.bridge_x_m + L.bridge_half_width_m + 1.0);
+  std::sort(keep_out.begin(), keep_out.end());
+  std::vector<std::pair<double, double>> out;
+  auto gap = [&](double len) { return rng->uniform(0.0, 2.0) * len * (1 - share) / share; };
+  double x = L.x0_m + gap(6.5);
+  while (x < L.x1_m) {
+    const double len = rng->uniform(3.0, 10.0);
+    double a = x;
+    const double b = std::min(x + len, L.x1_m);
+    for (const auto& [k0, k1] : keep_out) {
+      if (k1 <= a || k0 >= b) continue;
+      if (k0 - a >= 1.0) out.emplace_back(a, k0);
+      a = std::max(a, k1);
+    }
+    if (b - a >= 1.0) out.emplace_back(a, b);
+    x = b + gap(len);
+  }
+  return out;
+}
+
+// One undercut stretch [x0, x1) of a bank: stations every 0.25 m at u = (i + 0.5) / steps, the
+// lip (its top from where the slope stands h_l above the water, a jagged front, its
+// underside 0.15 m lower back into the slope) reaching taper(u) = sqrt(sin(pi u)) of the way
+// from the slope out to d beyond the water's edge, and under it the slope's foot in shade, 2 cm
+// in front of the slope, from below the water up to the underside.
+void add_undercut(MeshBuilder* lip, MeshBuilder* hollow, const Bank& k, double x0, double x1,
+                  int side, Rng* rng) {
+  constexpr double kThick_m = 0.15, kShadeOffset_m = 0.02, kRepeat_m = 4.0;
+  const double h_l = std::min(rng->uniform(0.3, 0.6), 0.7 * k.H);
+  const double d = rng->uniform(0.2, 0.4);
+  const double s_root = h_l / k.tan_slope, s_under = (h_l - kThick_m) / k.tan_slope;
+  const int steps = std::max(2, static_cast<int>(std::ceil((x1 - x0) / 0.25)));
+  const double cos_a = 1 / std::sqrt(1 + k.tan_slope * k.tan_slope);
+  const Vec3 slope_n(0, -side * k.tan_slope * cos_a, -cos_a);  // up and towards the river
+  auto at = [&](double x, double s, double h) { return Vec3(x, side * (k.b + s), -h); };
+  struct Station {
+    double x, s_front, h_top, s_shade;
+  };
+  std::vector<Station> st;
+  for (int i = 0; i < steps; ++i) {
+    const double u = (i + 0.5) / steps;
+    const double tau = std::sqrt(std::sin(kPi * u));
+    const double reach = d * rng->uniform(0.75, 1.25);  // the jagged front
+    st.push_back({x0 + (x1 - x0) * u, s_under - tau * (s_under + reach), h_l - (1 - tau) * kThick_m,
+                  s_under - tau * (s_under + 0.15)});
+  }
+  const Vec3 up(0, 0, -1), down(0, 0, 1), river(0, -side, 0);
+  const double h_u = h_l - kThick_m;
+  for (std::size_t i = 0; i + 1 < st.size(); ++i) {
+    const Station &a = st[i], &b = st[i + 1];
+    lip->quad_m(at(a.x, s_root, h_l), at(b.x, s_root, h_l), at(b.x, b.s_front, b.h_top),
+                at(a.x, a.s_front, a.h_top), up, kRepeat_m, kRepeat_m);
+    lip->quad_m(at(a.x, a.s_front, a.h_top), at(b.x, b.s_front, b.h_top), at(b.x, b.s_front, h_u),
+                at(a.x, a.s_front, h_u), river, kRepeat_m, kRepeat_m);
+    lip->quad_m(at(a.x, a.s_front, h_u), at(b.x, b.s_front, h_u), at(b.x, s_under, h_u),
+                at(a.x, s_under, h_u), down, kRepeat_m, kRepeat_m);
+    auto shade = [&](double x, double s) {
+      return Vec3(at(x, s, s * k.tan_slope) + kShadeOffset_m * slope_n);
+    };
+    hollow->quad_m(shade(a.x, a.s_shade), shade(b.x, b.s_shade), shade(b.x, s_under),
+                   shade(a.x, s_under), slope_n, kRepeat_m, kRepeat_m);
+  }
+}
+
+void add_bank_undercuts(sim::SceneGeometry* g, const RiverTileLayout& L, const Bank& k,
+                        const Textures& tex, const RiverReachOptions& options, std::uint64_t seed) {
+  if (options.bank_undercut_share <= 0 || k.H < 0.5 || k.run < 0.5) return;
+  MeshBuilder lip(tile_name(L.index, "bank_undercut"), solid(tex.soil, 0.75f));
+  MeshBuilder hollow(tile_name(L.index, "bank_undercut_hollow"), solid(tex.soil, 0.3f));
+  Rng ru = RngStreams(seed).stream("scene.river.tile." + std::to_string(L.index) + ".undercuts");
+  for (int side : {1, -1})
+    for (const auto& [x0, x1] : plan_undercuts(L, options.bank_undercut_share, side, &ru))
+      add_undercut(&lip, &hollow, k, x0, x1, side, &ru);
+  if (lip.triangle_count() == 0) return;
+  add_mesh(g, lip.take());
+  add_mesh(g, hollow.take());
+}
+
 // Bushes (willow scrub) on the bank between the reeds and the tree line,
 // drawn after the trees so that they do not move them.
 std::vector<TreeSpec> plan_bushes(const RiverReachOptions& o, const Bank& k, const Noise& n,
@@ -1105,6 +1193,7 @@ sim::SceneGeometry build_river_reach(const RiverReachOptions& options, Sky sky, 
     add_reeds(&g, L, k, n, tex, options, seed, index);
     add_waterline_stones(&g, L, k, n, tex, options, seed, index);
     add_bank_roots(&g, L, k, n, tex, options, seed);
+    add_bank_undercuts(&g, L, k, tex, options, seed);
 
     if (L.bridge) add_bridge(&g, L, k, n, tex);
     if (L.quay) add_quay(&g, L, k, tex, options);

@@ -89,6 +89,7 @@ struct RiverReachOptions {
   double waterline_stones_per_m = 1.5;
   double far_trees_per_m = 0.1;
   int bank_roots_per_tree = 4;
+  double bank_undercut_share = 0;
   double tree_detail_distance_m = 7.0;
   double texture_contrast = 2.0;
   bool photographs = true;
@@ -175,6 +176,13 @@ struct RiverReachOptions {
       "out over the toe and into the water within 1.5 m of the trunk's line; none where the "
       "slope runs less than 0.5 m (a vertical bank, or none); 0: none",
       yaml::in_range(0, 12));
+    a("bank_undercut_share", bank_undercut_share,
+      "Share of each bank's length undercut by the current, in stretches of 3-10 m: a lip of "
+      "earth 0.15 m thick, 0.3-0.6 m above the water, overhanging the water's edge by up to "
+      "0.4 m (jagged, tapering at each stretch's ends), over the slope's foot in its shade "
+      "(the soil at 0.4 of its albedo); none at the quay or the bridge, nor on a bank lower "
+      "than 0.5 m or whose slope runs less than 0.5 m; 0: none",
+      yaml::in_range(0, 1));
     a("tree_detail_distance_m", tree_detail_distance_m,
       "Trees at most this far behind the water's edge get twigs and the full set of cards; "
       "those further back three-sided limbs and half the cards (skeleton trees only)",

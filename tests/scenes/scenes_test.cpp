@@ -859,6 +859,55 @@ TEST(RiverReach, BankRootsRunFromTheSlopeIntoTheWater) {
   }
 }
 
+// bank_undercut_share: stretches of bank where a lip of earth overhangs the water's edge with
+// the slope's foot in its shade under it; none by default. Rays from mid-river just above the
+// water find the shade where the bank is undercut and the bare slope elsewhere; rays down
+// through the water's edge find the lip's top 0.15-0.6 m above the water.
+TEST(RiverReach, UndercutBanksOverhangTheWatersEdge) {
+  EXPECT_FALSE(find_mesh(default_reach(), "tile0.bank_undercut"));
+  RiverReachOptions o = river_defaults();
+  EXPECT_EQ(o.bank_undercut_share, 0);
+  o.vegetation_density = 0;  // nothing between the rays and the bank
+  o.waterline_stones_per_m = 0;
+  o.bank_roots_per_tree = 0;
+  const double b = o.bank_distance_m;
+  auto shaded_share = [&](double share, double* lip_hits) {
+    o.bank_undercut_share = share;
+    const auto g = build_river_reach(o, Sky::kOvercast, kSeed, 0, 120);
+    const RiverTileLayout L = plan_river_tile(o, kSeed, 0);
+    RayCaster rc(g);
+    int shaded = 0, bare = 0, lips = 0, downs = 0;
+    for (double x = L.x0_m + 0.1; x < L.x1_m; x += 0.5) {
+      if (L.bridge && std::abs(x - L.bridge_x_m) < L.bridge_half_width_m + 1.5) continue;
+      if (L.quay && x > L.quay_x0_m - 1.5 && x < L.quay_x1_m + 1.5) continue;
+      std::string what;
+      rc.cast({x, 0, -0.03}, {0, 1, 0}, &what);
+      shaded += what == "tile0.bank_undercut_hollow";
+      bare += what == "tile0.bank_east";
+      const double down = rc.cast({x, b - 0.05, -3.0}, {0, 0, 1}, &what);
+      if (what != "tile0.bank_undercut") continue;
+      ++downs;
+      const double h = 3.0 - down;  // the lip's top above the water
+      lips += h >= 0.15 - 1e-6 && h <= 0.6 + 1e-6;
+    }
+    *lip_hits = downs > 0 ? static_cast<double>(lips) / downs : 0;
+    return static_cast<double>(shaded) / std::max(1, shaded + bare);
+  };
+  double lip_ok = 0;
+  const double all = shaded_share(1.0, &lip_ok);
+  EXPECT_GT(all, 0.5);  // the stretches' tapered ends leave the rest bare
+  EXPECT_EQ(lip_ok, 1.0);
+  const double some = shaded_share(0.3, &lip_ok);
+  EXPECT_GT(some, 0.05);
+  EXPECT_LT(some, all);
+  EXPECT_EQ(lip_ok, 1.0);
+  // No lip where there is no slope to undercut.
+  o.bank_undercut_share = 1;
+  o.bank_slope_deg = 90;
+  EXPECT_FALSE(
+      find_mesh(build_river_reach(o, Sky::kOvercast, kSeed, 0, 120), "tile0.bank_undercut"));
+}
+
 // waterline_stones_per_m: that many stones a metre of bank on each side (less the quay's and
 // the bridge's gaps), each a faceted lump within 0.43 m of its centre near the water's edge;
 // 1.5 by default; none at 0.
@@ -1034,7 +1083,8 @@ TEST(RiverReach, ExtremeOptionsStillGiveWellFormedScenes) {
   cases[3].river_width_m = 1.0;
   cases[4].bank_slope_deg = 1;  // a bank that is almost a beach
   cases[4].texture_contrast = 4;
-  cases[5].bank_distance_m = 60;  // a wide river
+  for (auto& c : cases) c.bank_undercut_share = 1;  // every bank undercut where it can be
+  cases[5].bank_distance_m = 60;                    // a wide river
   cases[5].river_width_m = 120;
   cases[5].tree_height_m = 30;
   for (std::size_t i = 0; i < cases.size(); ++i) {
