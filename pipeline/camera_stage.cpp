@@ -48,6 +48,7 @@ CameraStage::CameraStage(const Scenario& sc, sim::StereoRenderer* renderer, cons
       T_B_C_(camera_mount_T_B_C(sc.sensors.camera.mount)),
       blur_samples_(sc.render.motion_blur_samples),
       blur_step_px_(sc.render.motion_blur_step_px),
+      single_sampled_(sc.render.msaa_samples == 1),
       camera_{.fx = sc.sensors.camera.fx_px,
               .fy = sc.sensors.camera.fy_px,
               .cx = sc.sensors.camera.cx_px,
@@ -120,24 +121,29 @@ int CameraStage::rolling_bands(const FrameTruth& truth) const {
 }
 
 sim::StereoImages CameraStage::render_at(const FrameTruth& truth,
-                                         const std::vector<ShutterBand>& bands, double d_s) {
+                                         const std::vector<ShutterBand>& bands, double d_s,
+                                         bool moving_mask) {
   std::vector<sim::RowBand> left, right;
   for (const ShutterBand& b : bands) {
     const double dl = b.dt_s + d_s, dr = dl + last_right_offset_s_;
     left.push_back({T_W_C(truth, dl), truth.t_s + dl, b.row_begin, b.row_end});
     right.push_back({T_W_C(truth, dr), truth.t_s + dr, b.row_begin, b.row_end});
   }
-  return renderer_->render_bands(left, right);
+  return renderer_->render_bands(left, right, moving_mask);
 }
 
-sim::StereoImages CameraStage::render_blurred(const FrameTruth& truth) {
+sim::StereoImages CameraStage::render_blurred(const FrameTruth& truth, bool moving_mask) {
   const double exposure_s = exposure_ms_ * 1e-3;
   const int samples = blur_samples(truth);
   last_blur_samples_ = samples;
   last_rolling_bands_ = rolling_bands(truth);
   const std::vector<ShutterBand> bands =
       shutter_bands(camera_.height, line_delay_s_, last_rolling_bands_);
-  if (samples <= 1) return render_at(truth, bands, 0.0);
+  if (samples <= 1) {
+    // The left image is the ideal camera at the centre of the exposure: one band at dt 0.
+    const bool mask = moving_mask && single_sampled_ && bands.size() == 1 && bands[0].dt_s == 0;
+    return render_at(truth, bands, 0.0, mask);
+  }
   // Sub-frame instants at the centres of `samples` equal parts of the exposure.
   std::vector<std::uint32_t> sum_left, sum_right;
   sim::StereoImages out;
@@ -164,11 +170,37 @@ sim::StereoImages CameraStage::render_blurred(const FrameTruth& truth) {
   return out;
 }
 
-sim::StereoImages CameraStage::capture(const FrameTruth& truth) {
+sim::StereoImages CameraStage::capture_with_truth(const FrameTruth& truth, bool depth, bool mask,
+                                                  double* moving_px) {
+  const bool moving = renderer_->has_moving_things();
+  sim::StereoImages img = capture(truth, !depth && (mask || moving));
+  *moving_px = 0;
+  if (!img.moving_left.pixels.empty()) {
+    *moving_px = moving_share(img.moving_left);
+    if (!mask) img.moving_left = {};
+    return img;
+  }
+  if (depth || mask || moving) {
+    sim::TruthImages t = renderer_->render_truth(T_W_C(truth), truth.t_s);
+    *moving_px = moving_share(t.moving);
+    if (depth) img.depth_left = std::move(t.depth);
+    if (depth || mask) img.moving_left = std::move(t.moving);
+  }
+  return img;
+}
+
+double moving_share(const sim::GrayImage& mask) {
+  if (mask.pixels.empty()) return 0;
+  const auto n =
+      std::count_if(mask.pixels.begin(), mask.pixels.end(), [](std::uint8_t v) { return v != 0; });
+  return static_cast<double>(n) / static_cast<double>(mask.pixels.size());
+}
+
+sim::StereoImages CameraStage::capture(const FrameTruth& truth, bool moving_mask) {
   last_right_offset_s_ = right_offset_s_;
   if (right_jitter_s_ > 0)
     last_right_offset_s_ += right_jitter_s_ * std::clamp(right_jitter_.normal(), -3.0, 3.0);
-  sim::StereoImages img = render_blurred(truth);
+  sim::StereoImages img = render_blurred(truth, moving_mask);
   // Lens and noise of the two cameras are independent (separate streams):
   // the left one runs on a second thread, the bytes are the same either way.
   auto process = [this](sim::GrayImage* gray, sim::CameraImageNoise* noise) {

@@ -64,12 +64,25 @@ struct FrameTruth {
   Vec6 twist_B = Vec6::Zero();  // [v_B; w_B]: body-frame velocity and angular rate
 };
 
+/// The share of a mask's pixels that are set (non-zero); 0 for an empty mask.
+double moving_share(const sim::GrayImage& mask);
+
 class CameraStage {
  public:
   /// `renderer` must outlive the stage; its right camera is set to the true rig.
   CameraStage(const Scenario& sc, sim::StereoRenderer* renderer, const RngStreams& rng);
-  /// Renders and processes one stereo pair (8-bit grayscale, rectified).
-  sim::StereoImages capture(const FrameTruth& truth);
+  /// Renders and processes one stereo pair (8-bit grayscale, rectified). With `moving_mask`,
+  /// also the left image's moving things (moving_left) from its own pass where that pass is the
+  /// ideal camera at the centre of the exposure (one render: no motion blur, one band, no
+  /// multisampling); moving_left stays empty where it is not.
+  sim::StereoImages capture(const FrameTruth& truth, bool moving_mask = false);
+  /// capture(), and the left camera's ground truth at the centre of the exposure: with `depth`
+  /// its depth in depth_left; with `depth` or `mask` its moving mask in moving_left; always
+  /// the share of its pixels that show moving things in *moving_px (0 when nothing moves). The
+  /// mask comes from the left image's own pass where capture() can give it (the same pixels as
+  /// render_truth's: tests/sim/render_test.cpp), from render_truth's pass otherwise.
+  sim::StereoImages capture_with_truth(const FrameTruth& truth, bool depth, bool mask,
+                                       double* moving_px);
   /// The exposure of the next frame [ms] (changes frame to frame with auto exposure).
   double exposure_ms() const { return exposure_ms_; }
   /// How many renders the blur of a frame with this truth takes: motion_blur_samples, or with
@@ -99,10 +112,10 @@ class CameraStage {
   SE3 T_W_C(const FrameTruth& truth, double dt_s) const;
 
  private:
-  sim::StereoImages render_blurred(const FrameTruth& truth);
+  sim::StereoImages render_blurred(const FrameTruth& truth, bool moving_mask);
   // One render of the pair, every row exposed d_s after its own time.
   sim::StereoImages render_at(const FrameTruth& truth, const std::vector<ShutterBand>& bands,
-                              double d_s);
+                              double d_s, bool moving_mask = false);
   // The image motion [px] of the left camera's four corners from pose a to pose b (C(a) <- C(b)
   // relative motion), points at depth `depth_m`.
   double corner_motion_px(const SE3& T_a_b, double depth_m) const;
@@ -111,6 +124,7 @@ class CameraStage {
   SE3 T_B_C_;
   int blur_samples_;
   double blur_step_px_;
+  bool single_sampled_;   // render.msaa_samples 1: the left eye's pass can give the moving mask
   PinholeCamera camera_;  // the left camera's intrinsics, for blur_samples()
   int last_blur_samples_ = 1;
   sim::Shutter shutter_;

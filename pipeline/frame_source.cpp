@@ -29,13 +29,6 @@ cv::Mat cv_view(const sim::DepthImage& d) {
   return cv::Mat(d.height, d.width, CV_32FC1, const_cast<float*>(d.depth_m.data()));
 }
 
-double moving_share(const sim::GrayImage& mask) {
-  if (mask.pixels.empty()) return 0;
-  const auto n =
-      std::count_if(mask.pixels.begin(), mask.pixels.end(), [](std::uint8_t v) { return v != 0; });
-  return static_cast<double>(n) / static_cast<double>(mask.pixels.size());
-}
-
 int run_threads(int requested) {
   if (requested > 0) return requested;
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
@@ -59,16 +52,8 @@ struct Renderer {
     f.k = k;
     const Stopwatch watch;
     f.exposure_ms = camera->exposure_ms();  // this frame's (auto exposure)
-    f.images = camera->capture(truth);
+    f.images = camera->capture_with_truth(truth, depth, depth, &f.moving_px);
     f.blur_samples = camera->last_blur_samples();
-    if (depth || renderer.has_moving_things()) {  // ground truth at the centre of the exposure
-      sim::TruthImages t = renderer.render_truth(camera->T_W_C(truth), truth.t_s);
-      f.moving_px = moving_share(t.moving);
-      if (depth) {
-        f.images.depth_left = std::move(t.depth);
-        f.images.moving_left = std::move(t.moving);
-      }
-    }
     f.render_ms = watch.ms();
     return f;
   }

@@ -83,9 +83,6 @@ class FrameSource {
 cv::Mat cv_view(const sim::GrayImage& image);
 cv::Mat cv_view(const sim::DepthImage& depth);
 
-/// The share of a mask's pixels that are set (non-zero); 0 for an empty mask.
-double moving_share(const sim::GrayImage& mask);
-
 /// The threads a run uses: `requested`, or every core when it is 0.
 int run_threads(int requested);
 

@@ -133,15 +133,9 @@ RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesyst
   for (std::size_t k = 0; k < poses.size(); ++k) {
     if (k < stamps.size() && stamps[k].dropped) continue;
     const auto t0 = SteadyClock::now();
-    sim::StereoImages img = camera.capture(truth[k]);
     double moving_px = 0;
     // Ground truth: the ideal pinhole camera at the centre of the exposure.
-    if (depth || options.masks || renderer.has_moving_things()) {
-      sim::TruthImages t = renderer.render_truth(poses[k].T_W_C, ns_to_seconds(poses[k].t_ns));
-      moving_px = moving_share(t.moving);
-      img.depth_left = std::move(t.depth);
-      img.moving_left = std::move(t.moving);
-    }
+    sim::StereoImages img = camera.capture_with_truth(truth[k], depth, options.masks, &moving_px);
     render_s += seconds_since(t0);
     ++delivered;
     const std::string name = fmt::format("{:06d}", k);

@@ -237,8 +237,15 @@ struct StereoRenderer::Impl {
   void draw_eye_rows(const SE3& T_W_C, double t, int eye, int row_begin, int row_end);
   // Resolves the multisampled rows [row_begin, row_end) (all rows by default) into resolve_tex.
   void resolve_eye(int eye, int row_begin = 0, int row_end = -1);
-  GrayImage read_eye(int eye);
+  // `channel` GL_RED: the image; GL_GREEN: the left eye's moving mask (left_mask_target).
+  GrayImage read_eye(int eye, unsigned channel = GL_RED);
   TruthImages render_truth(const SE3& T_W_C, double t);
+  // The left eye's single-sampled target becomes RG8 (gray in red, the scene shader's moving
+  // flag in green), once: 4 % slower than R8 on llvmpipe, so only when a mask is asked for.
+  void use_left_mask_target();
+  bool left_mask_target = false;
+  // render(), and with `moving_mask` the left eye's mask (render_bands).
+  StereoImages render_pair(const SE3& T_W_C_left, double t_s, bool with_depth, bool moving_mask);
 };
 
 StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& options, ImageKind kind)
@@ -698,7 +705,7 @@ void StereoRenderer::Impl::draw_mesh(GLuint prog, const GpuMesh& g) {
   glUniform1f(loc(prog, "u_specular"), g.material.specular);
   glUniform3fv(loc(prog, "u_tint"), 1, g.material.colour.data());
   set_mat4(prog, "u_model", model_of(g));
-  glUniform1f(loc(prog, "u_moving"), g.mover >= 0 ? 1.f : 0.f);  // depth pass only
+  glUniform1f(loc(prog, "u_moving"), g.mover >= 0 ? 1.f : 0.f);  // the moving mask
   glBindVertexArray(g.vao);
   glDrawElements(GL_TRIANGLES, g.count, GL_UNSIGNED_INT, nullptr);
 }
@@ -955,7 +962,23 @@ void StereoRenderer::Impl::draw_eye(const SE3& T_W_C, double t, int eye_index) {
   resolve_eye(eye_index);
 }
 
-GrayImage StereoRenderer::Impl::read_eye(int eye_index) {
+void StereoRenderer::Impl::use_left_mask_target() {
+  if (left_mask_target) return;
+  DRIFTLAB_DEMAND(!colour && options.msaa_samples == 1);
+  EyeTargets& e = eyes[0];
+  glBindFramebuffer(GL_FRAMEBUFFER, e.msaa_fbo);
+  glDeleteRenderbuffers(1, &e.msaa_color);
+  glGenRenderbuffers(1, &e.msaa_color);
+  glBindRenderbuffer(GL_RENDERBUFFER, e.msaa_color);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RG8, rig.camera.width, rig.camera.height);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, e.msaa_color);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw InternalError("renderer: incomplete framebuffer for the moving mask");
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  left_mask_target = true;
+}
+
+GrayImage StereoRenderer::Impl::read_eye(int eye_index, unsigned channel) {
   const EyeTargets& e = eyes[static_cast<std::size_t>(eye_index)];
   const int W = rig.camera.width, H = rig.camera.height;
   // Without multisampling the colour buffer is read directly (no resolve).
@@ -964,7 +987,7 @@ GrayImage StereoRenderer::Impl::read_eye(int eye_index) {
   img.width = W;
   img.height = H;
   img.pixels.resize(static_cast<std::size_t>(W) * H);
-  glReadPixels(0, 0, W, H, GL_RED, GL_UNSIGNED_BYTE, img.pixels.data());
+  glReadPixels(0, 0, W, H, channel, GL_UNSIGNED_BYTE, img.pixels.data());
   lap(&RenderPassTimes::readback_ms);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return img;
@@ -979,8 +1002,10 @@ TruthImages StereoRenderer::Impl::render_truth(const SE3& T_W_C, double t) {
   glClearColor(0, 0, 0, 0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
-  draw_scene(view, eye, 1.f, 1, t);
+  // In the eye pass's order (draw_eye_rows): where the water and a surface meet at the same
+  // depth, the pixel shows the water, in the image and here.
   draw_water(view, eye, t, 1, 0);
+  draw_scene(view, eye, 1.f, 1, t);
   glFinish();
   const std::size_t n = static_cast<std::size_t>(W) * H;
   std::vector<float> rg(2 * n);
@@ -1094,30 +1119,38 @@ void StereoRenderer::set_right_camera(const SE3& T_left_right) {
 }
 
 StereoImages StereoRenderer::render(const SE3& T_W_C_left, double t_s, bool with_depth) {
-  impl_->context->make_current();
-  impl_->lap_start();
-  ++impl_->times.renders;
-  if (with_depth) ++impl_->times.truths;
+  return impl_->render_pair(T_W_C_left, t_s, with_depth, false);
+}
+
+StereoImages StereoRenderer::Impl::render_pair(const SE3& T_W_C_left, double t_s, bool with_depth,
+                                               bool moving_mask) {
+  context->make_current();
+  lap_start();
+  ++times.renders;
+  if (with_depth) ++times.truths;
+  if (moving_mask) use_left_mask_target();
   StereoImages out;
-  const SE3 T_W_C_right = T_W_C_left * impl_->T_left_right;
+  const SE3 T_W_C_right = T_W_C_left * T_left_right;
   // Both mirror images first: an eye's image samples its own, and llvmpipe makes this thread
   // wait until a texture it samples is rasterised; so the right mirror image's vertices are
   // processed while the left one is rasterised, and so on (6 % faster than eye by eye).
-  if (impl_->reflects()) {
-    impl_->draw_reflection(T_W_C_left, t_s, 0);
-    impl_->draw_reflection(T_W_C_right, t_s, 1);
+  if (reflects()) {
+    draw_reflection(T_W_C_left, t_s, 0);
+    draw_reflection(T_W_C_right, t_s, 1);
   }
-  impl_->draw_eye(T_W_C_left, t_s, 0);
-  impl_->draw_eye(T_W_C_right, t_s, 1);
-  if (with_depth) out.depth_left = impl_->render_truth(T_W_C_left, t_s).depth;
-  out.left = impl_->read_eye(0);
-  out.right = impl_->read_eye(1);
+  draw_eye(T_W_C_left, t_s, 0);
+  draw_eye(T_W_C_right, t_s, 1);
+  if (with_depth) out.depth_left = render_truth(T_W_C_left, t_s).depth;
+  out.left = read_eye(0);
+  out.right = read_eye(1);
+  if (moving_mask) out.moving_left = read_eye(0, GL_GREEN);
   return out;
 }
 
 StereoImages StereoRenderer::render_bands(const std::vector<RowBand>& left,
-                                          const std::vector<RowBand>& right) {
+                                          const std::vector<RowBand>& right, bool moving_mask) {
   Impl& m = *impl_;
+  DRIFTLAB_DEMAND(!moving_mask || (left.size() == 1 && !m.colour && m.options.msaa_samples == 1));
   const int H = m.rig.camera.height;
   const std::array<const std::vector<RowBand>*, 2> bands = {&left, &right};
   for (const auto* eye_bands : bands) {
@@ -1130,10 +1163,11 @@ StereoImages StereoRenderer::render_bands(const std::vector<RowBand>& left,
   }
   if (left.size() == 1 && right.size() == 1 && left[0].t_s == right[0].t_s &&
       left[0].T_W_C.matrix() == right[0].T_W_C.matrix())
-    return render(left[0].T_W_C, left[0].t_s, false);
+    return m.render_pair(left[0].T_W_C, left[0].t_s, false, moving_mask);
   m.context->make_current();
   m.lap_start();
   ++m.times.renders;
+  if (moving_mask) m.use_left_mask_target();
   // Band by band: each band's mirror image from its own pose, then its rows.
   for (int eye = 0; eye < 2; ++eye) {
     m.clear_eye(eye);
@@ -1149,6 +1183,7 @@ StereoImages StereoRenderer::render_bands(const std::vector<RowBand>& left,
   StereoImages out;
   out.left = m.read_eye(0);
   out.right = m.read_eye(1);
+  if (moving_mask) out.moving_left = m.read_eye(0, GL_GREEN);
   return out;
 }
 

@@ -135,8 +135,12 @@ class StereoRenderer {
   StereoImages render(const SE3& T_W_C_left, double t_s, bool with_depth);
   /// Renders each eye band by band (bands in row order, together covering every row once),
   /// each band's rows from its own pose and time; the right eye's bands give the left
-  /// camera's pose at the right image's times. Without depth.
-  StereoImages render_bands(const std::vector<RowBand>& left, const std::vector<RowBand>& right);
+  /// camera's pose at the right image's times. Without depth. With `moving_mask`, also
+  /// the left image's moving things in moving_left, written by the left eye's own pass (the
+  /// scene shader's flag in a second channel): render_truth's mask at the band's pose and time
+  /// without its pass. Needs one left band, a gray renderer and no multisampling.
+  StereoImages render_bands(const std::vector<RowBand>& left, const std::vector<RowBand>& right,
+                            bool moving_mask = false);
 
   /// The left camera's depth and moving-things mask at pose T_W_C and time t_s, in one pass
   /// (render(..., true)'s depth is this pass's).

@@ -40,9 +40,13 @@ uniform vec2 u_wind_dir;
 uniform vec2 u_flutter;    // amplitude [m], phase at this instant [rad]
 uniform vec2 u_sway_reach; // the most a unit weight sways and flutters [m]
 uniform float u_moving;    // 1 for a mover's mesh
+#if SWAY
+// 1: a moving thing: the green channel of the moving mask (the truth pass) and of the left
+// eye's gray image (render_bands' moving_mask). Without sway it is u_moving (kSceneFs).
+out float v_moving;
+#endif
 #if DEPTH
 out float v_view_z;
-out float v_moving;        // 1: a moving thing (the green channel: the moving mask)
 #if CUTOUT
 out vec2 v_uv;
 #endif
@@ -67,9 +71,11 @@ void main() {
 #endif
   vec3 p = vec3(w.xy, w.z * u_mirror);
   vec4 c = u_view * vec4(p, 1.0);
+#if SWAY
+  v_moving = moving;
+#endif
 #if DEPTH
   v_view_z = c.z;
-  v_moving = moving;
 #if CUTOUT
   v_uv = a_uv;
 #endif
@@ -115,8 +121,11 @@ uniform vec3 u_tint;       // the material's colour (COLOUR images only)
 uniform vec3 u_sun_dir;
 uniform float u_sky;
 uniform vec3 u_eye;
-#if DEPTH
+#if SWAY
 in float v_moving;
+#else
+uniform float u_moving;
+#define v_moving u_moving
 #endif
 out vec4 frag;
 void main() {
@@ -145,7 +154,7 @@ void main() {
 #if COLOUR
   frag = vec4(mix(vec3(u_sky), g * u_tint, v_uv_light_fog.w), 1.0);
 #else
-  frag = vec4(mix(u_sky, g, v_uv_light_fog.w), 0.0, 0.0, 1.0);
+  frag = vec4(mix(u_sky, g, v_uv_light_fog.w), v_moving > 0.5 ? 1.0 : 0.0, 0.0, 1.0);
 #endif
 #endif
 }

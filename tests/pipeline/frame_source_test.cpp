@@ -78,6 +78,24 @@ TEST(FrameSource, RenderThreadDeliversTheSerialFramesInOrderSkippingDropped) {
   EXPECT_FALSE(threaded.next().has_value());
 }
 
+// Without depth the moving share comes from the left image's own pass, with depth from
+// render_truth's (a second method): the same shares, the same images.
+TEST(FrameSource, MovingShareFromTheLeftImagesPassIsTheTruthPasss) {
+  const RiverLook s;
+  FrameSource plain(s.sc, s.scene, s.truth, s.stamps, 1);
+  FrameSource with_depth(s.sc, s.scene, s.truth, s.stamps, 1, 4, /*depth=*/true);
+  const auto a = all_frames(plain);
+  const auto b = all_frames(with_depth);
+  ASSERT_EQ(a.size(), 5u);
+  ASSERT_EQ(b.size(), a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_GT(a[i].moving_px, 0.001) << i;
+    EXPECT_EQ(a[i].moving_px, b[i].moving_px) << i;
+    EXPECT_TRUE(a[i].images.left.pixels == b[i].images.left.pixels) << i;
+    EXPECT_TRUE(a[i].images.moving_left.pixels.empty()) << i;  // kept only when asked for
+  }
+}
+
 TEST(FrameSource, ConsumerThatStopsEarlyDoesNotHangTheRenderThread) {
   const RiverLook s;
   for (const std::size_t taken : {0, 1}) {

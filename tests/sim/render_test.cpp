@@ -589,17 +589,13 @@ TEST(Render, HazeKeepsExpMinusDistanceOverItsLengthOfTheContrast) {
   }
 }
 
-// The moving things' mask (issue 46, item 5): a mover's mask is exactly the pixels whose depth
-// differs from a render of the scene without it (a second method), over water (its part under
-// the waterline is hidden) and behind a static wall that hides a part of it; and the mover is
-// where its closed-form motion puts it: a square facing the camera, moving east, has its mask's
-// centroid on the projection of its centre at each instant (a fronto-parallel square projects
-// affinely, so its area's centroid is its centre's image).
-TEST(Render, MoversMaskIsWhereTheirDepthDiffersFromTheSceneWithoutThem) {
+// Water, a static wall (its meshes first: *statics of them), a hull rolling and heaving across
+// the view behind it and a square sliding east (the movers).
+SceneGeometry movers_scene(std::size_t* statics) {
   SceneGeometry with = dark_scene();
   with.water.enabled = true;
   with.meshes = box_meshes(Vec3(7, 0.4, -2.5), Vec3(7.5, 1.5, -0.6), false);  // a static wall
-  const std::size_t statics = with.meshes.size();
+  *statics = with.meshes.size();
   for (Mesh m : box_meshes(Vec3(-0.3, -0.8, -0.9), Vec3(0.3, 0.8, 0.3), false)) {
     m.mover = 0;  // a hull in its own frame, 0.3 m of it under the water
     with.meshes.push_back(m);
@@ -618,6 +614,19 @@ TEST(Render, MoversMaskIsWhereTheirDepthDiffersFromTheSceneWithoutThem) {
   sliding.p0_W = Vec3(20, -3.0, -0.5);
   sliding.v_W = Vec3(0, 1.37, 0);
   with.movers = {hull, sliding};
+  return with;
+}
+
+// The moving things' mask (issue 46, item 5): a mover's mask is exactly the pixels whose depth
+// differs from a render of the scene without it (a second method), over water (its part under
+// the waterline is hidden) and behind a static wall that hides a part of it; and the mover is
+// where its closed-form motion puts it: a square facing the camera, moving east, has its mask's
+// centroid on the projection of its centre at each instant (a fronto-parallel square projects
+// affinely, so its area's centroid is its centre's image).
+TEST(Render, MoversMaskIsWhereTheirDepthDiffersFromTheSceneWithoutThem) {
+  std::size_t statics = 0;
+  const SceneGeometry with = movers_scene(&statics);
+  const MoverMotion sliding = with.movers[1];
   SceneGeometry without = with;
   without.meshes.resize(statics);
   without.movers.clear();
@@ -709,6 +718,51 @@ TEST(Render, SwayingSheetIsWhereItsGustsPutItAndInTheMask) {
     moved = std::max(moved, std::abs(west + 0.5));
   }
   EXPECT_GT(moved * 50, 1.0);  // the gusts moved it by a pixel or more
+}
+
+// The left eye's pass writes the moving mask beside its image (render_bands' moving_mask): the
+// same pixels as render_truth's pass (a second method), movers and a swaying sheet, with the
+// pair in step or the right image later; the images the same bytes as a renderer's that never
+// drew a mask. A rolling shutter's bands or multisampling cannot give it.
+TEST(Render, LeftPassMaskIsTheTruthPasssMask) {
+  std::size_t statics = 0;
+  SceneGeometry scene = movers_scene(&statics);
+  Mesh sheet = quad_mesh(
+      {Vec3(12, -3.5, -2.5), Vec3(12, -2.5, -2.5), Vec3(12, -2.5, -1.5), Vec3(12, -3.5, -1.5)},
+      -Vec3::UnitX(), true);
+  sheet.sway.assign(4, {1.f, 0.f});
+  scene.meshes.push_back(sheet);
+  WindOptions wind;
+  wind.speed_mps = 8;
+  const VegetationSway sway = vegetation_sway(wind, Rng(11));
+  StereoRenderer r(rig_640(), RenderOptions{}), plain(rig_640(), RenderOptions{});
+  for (StereoRenderer* x : {&r, &plain}) {
+    x->upload(scene);
+    x->set_sway(sway);
+  }
+  const SE3 T_W_C = camera_at(Vec3(0, 0, -1.0));
+  for (double t : {0.1, 0.8, 1.9}) {
+    const TruthImages truth = r.render_truth(T_W_C, t);
+    for (double right_later_s : {0.0, 0.02}) {
+      const std::vector<RowBand> left{{T_W_C, t, 0, 480}};
+      const std::vector<RowBand> right{{T_W_C, t + right_later_s, 0, 480}};
+      const StereoImages got = r.render_bands(left, right, true);
+      const StereoImages want = plain.render_bands(left, right);
+      EXPECT_TRUE(got.moving_left.pixels == truth.moving.pixels) << "t " << t;
+      EXPECT_GT(std::count(got.moving_left.pixels.begin(), got.moving_left.pixels.end(), 255), 3000)
+          << "t " << t;
+      EXPECT_TRUE(got.left.pixels == want.left.pixels) << "t " << t;
+      EXPECT_TRUE(got.right.pixels == want.right.pixels) << "t " << t;
+      EXPECT_TRUE(want.moving_left.pixels.empty());
+    }
+  }
+  const std::vector<RowBand> two{{T_W_C, 0.1, 0, 240}, {T_W_C, 0.1, 240, 480}};
+  EXPECT_THROW(r.render_bands(two, two, true), InternalError);
+  RenderOptions msaa;
+  msaa.msaa_samples = 4;
+  StereoRenderer multisampled(rig_640(), msaa);
+  const std::vector<RowBand> one{{T_W_C, 0.1, 0, 480}};
+  EXPECT_THROW(multisampled.render_bands(one, one, true), InternalError);
 }
 
 TEST(Render, BadRigIsAClearError) {
