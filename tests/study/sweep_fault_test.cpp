@@ -51,7 +51,9 @@ bool is_temporary(const fs::path& p) {
 
 // The files of a finished run and their bytes, without what differs between two
 // undisturbed runs: the completion marker (host, wall time), the timing block of
-// metrics.json and frames.csv's per-frame milliseconds (only its row count is kept).
+// metrics.json, its frame cache's state (with DRIFTLAB_FRAME_CACHE set, the first run
+// fills the cache and the next ones hit it) and frames.csv's per-frame milliseconds (only
+// its row count is kept).
 std::map<std::string, std::string> run_contents(const fs::path& run) {
   std::map<std::string, std::string> out;
   for (const auto& e : fs::recursive_directory_iterator(run)) {
@@ -63,6 +65,7 @@ std::map<std::string, std::string> run_contents(const fs::path& run) {
     if (rel == "metrics.json") {
       auto j = nlohmann::json::parse(bytes);
       j.erase("timing");
+      if (j.contains("frame_cache")) j["frame_cache"].erase("state");
       bytes = j.dump();
     }
     out[rel] = bytes;
