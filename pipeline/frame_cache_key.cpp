@@ -40,17 +40,30 @@ class Fingerprint {
   std::uint64_t h_ = fnv1a64("");
 };
 
-// The scenario with what decides no frame put back to its defaults: name, description,
-// evaluation, and the pipeline but for pipeline.max_frames. A section added to Scenario later
-// is in the key until it is named here (a needless miss, never a stale frame).
-Scenario frame_deciding(const Scenario& sc) {
+// The scenario's YAML without what decides no frame: its name and description, and the
+// sections `pipeline` and `eval` but for pipeline.max_frames. The sections are cut from the text
+// rather than put back to their defaults, so that a VO option added or a default changed (code
+// outside the renderer's identity) keeps the cached frames. A section added to Scenario later is
+// in the key until it is named here (a needless miss, never a stale frame).
+std::string frame_deciding_yaml(const Scenario& sc) {
   Scenario s = sc;
   s.name = Scenario{}.name;
   s.description.clear();
-  s.eval = eval::EvalOptions{};
-  s.pipeline = PipelineOptions{};
-  s.pipeline.max_frames = sc.pipeline.max_frames;
-  return s;
+  const std::string full = yaml::to_yaml(s, false);
+  std::string out;
+  bool skipping = false;
+  for (std::size_t begin = 0; begin < full.size();) {
+    const std::size_t end = std::min(full.find('\n', begin), full.size());
+    const std::string_view line(full.data() + begin, end - begin);
+    if (!line.empty() && line[0] != ' ' && line[0] != '-')  // a top-level key
+      skipping = line.starts_with("pipeline:") || line.starts_with("eval:");
+    if (!skipping) {
+      out.append(line);
+      out += '\n';
+    }
+    begin = end + 1;
+  }
+  return out + fmt::format("pipeline:\n  max_frames: {}\n", sc.pipeline.max_frames);
 }
 
 }  // namespace
@@ -130,10 +143,10 @@ std::string frame_cache_key(const std::string& identity, const Scenario& sc,
                             const sim::SceneGeometry& scene, const std::vector<FrameTruth>& truth,
                             const std::vector<sim::SampleTime>& stamps) {
   return fmt::format(
-      "driftlab frame cache key, version 2\n{}scene_fnv1a64 {}\ntruth_fnv1a64 {}\n"
+      "driftlab frame cache key, version 3\n{}scene_fnv1a64 {}\ntruth_fnv1a64 {}\n"
       "frames {}\n{}",
       identity, scene_fingerprint(scene), truth_fingerprint(truth, stamps), truth.size(),
-      yaml::to_yaml(frame_deciding(sc), false));
+      frame_deciding_yaml(sc));
 }
 
 }  // namespace driftlab::pipeline

@@ -295,6 +295,14 @@ TEST(FrameCacheKey, LeavesOutWhatOnlyTheVosFiltersAndEvaluationSee) {
     change(k);
     EXPECT_EQ(k.key(), base) << what;
   }
+  // Nor are the VOs' and the evaluation's option names (not even at their defaults), so that a
+  // VO option added or a VO default changed, code outside the renderer's identity, keeps the
+  // cached frames; max_frames is the one pipeline line.
+  for (const char* name : {"ransac_iterations", "sgbm_mode", "fusion", "section_length_m"})
+    EXPECT_EQ(base.find(name), std::string::npos) << name;
+  EXPECT_NE(base.find("\npipeline:\n  max_frames: 0\n"), std::string::npos) << base;
+  EXPECT_NE(base.find("\nseed: "), std::string::npos);
+  EXPECT_NE(base.find("\nsensors:\n"), std::string::npos);
 }
 
 }  // namespace
