@@ -461,33 +461,55 @@ TEST(SparseMotionTest, SubPixelMotionWithWrongDisparitiesNeedsTheDefaultThreshol
   };
   SparseVoOptions libviso2;
   libviso2.inlier_threshold_px = 2.0;
-  int failed_default = 0, failed_libviso2 = 0;
-  double worst_default_m = 0.0;
+  // MSAC (ransac_score msac) at 2 px: the turn fits every match, but loosely; the true motion
+  // fits all but the wrong ones to 0.05 px, and its truncated cost is the lower.
+  SparseVoOptions msac_2px = libviso2;
+  msac_2px.ransac_score = RansacScore::kMsac;
+  const SparseVoOptions defaults;
+  const std::array<const SparseVoOptions*, 3> variants = {&defaults, &libviso2, &msac_2px};
+  std::array<int, 3> failed = {};
+  std::array<double, 3> worst_m = {};
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
     const auto m = matches(seed);
-    for (const SparseVoOptions& o : {SparseVoOptions{}, libviso2}) {
-      StereoMotionEstimator est(rig, o);
+    for (std::size_t v = 0; v < variants.size(); ++v) {
+      StereoMotionEstimator est(rig, *variants[v]);
       Rng rng(100 + seed);
       const auto r = est.estimate(m, &rng);
       ASSERT_TRUE(r.ok) << r.failure;
       const double error_m =
           (r.T_curr_prev.inverse().translation() - T_prev_curr.translation()).norm();
-      const bool failed = error_m > 0.25 * T_prev_curr.translation().norm();
-      if (o.inlier_threshold_px == SparseVoOptions{}.inlier_threshold_px) {
-        failed_default += failed ? 1 : 0;
-        worst_default_m = std::max(worst_default_m, error_m);
-      } else {
-        failed_libviso2 += failed ? 1 : 0;
-      }
+      failed[v] += error_m > 0.25 * T_prev_curr.translation().norm() ? 1 : 0;
+      worst_m[v] = std::max(worst_m[v], error_m);
     }
   }
   std::printf(
       "[ sparse   ] 20 frames, motion off by more than 25 %%: %d at 1 px (worst %.2f mm), "
-      "%d at 2 px\n",
-      failed_default, worst_default_m * 1e3, failed_libviso2);
-  EXPECT_EQ(failed_default, 0);
-  EXPECT_LT(worst_default_m, 0.1 * T_prev_curr.translation().norm());
-  EXPECT_GE(failed_libviso2, 5) << "the case no longer tells the thresholds apart";
+      "%d at 2 px, %d at 2 px with MSAC (worst %.2f mm)\n",
+      failed[0], worst_m[0] * 1e3, failed[1], failed[2], worst_m[2] * 1e3);
+  EXPECT_EQ(failed[0], 0);
+  EXPECT_LT(worst_m[0], 0.1 * T_prev_curr.translation().norm());
+  EXPECT_GE(failed[1], 5) << "the case no longer tells the thresholds apart";
+  EXPECT_EQ(failed[2], 0);
+  EXPECT_LT(worst_m[2], 0.1 * T_prev_curr.translation().norm());
+}
+
+TEST(SparseMotionTest, MsacCostIsTheTruncatedSquaredError) {
+  const StereoRig rig = test::rig_640x480();
+  const SE3 T(Quat(Eigen::AngleAxisd(1 * kDeg, Vec3::UnitY())), Vec3(0.02, 0.0, -0.3));
+  auto m = synthetic_matches(rig, T, 4, 0.0, 0.0, 11);
+  m[0].u_l += 0.3;  // left 0.3^2 + 0.4^2 = 0.25 against right 0.2^2: 0.25
+  m[0].v_l += 0.4;
+  m[0].u_r += 0.2;
+  m[0].v_r = m[0].v_l - 0.4;
+  m[1].u_r -= 0.6;  // the right image's 0.36
+  m[2].v_l += 3.0;  // beyond the 1 px threshold: 1
+  m[2].v_r = m[2].v_l - 3.0;
+  m[3].p_prev = -m[3].p_prev;  // behind the camera: 1
+  StereoMotionEstimator est(rig, SparseVoOptions{});
+  EXPECT_NEAR(est.msac_cost(m, T), 0.25 + 0.36 + 1.0 + 1.0, 1e-9);
+  SparseVoOptions two_px;
+  two_px.inlier_threshold_px = 2.0;
+  EXPECT_NEAR(StereoMotionEstimator(rig, two_px).msac_cost(m, T), 0.25 + 0.36 + 4.0 + 4.0, 1e-9);
 }
 
 TEST(SparseMotionTest, RansacReportsTooFewMatches) {

@@ -22,6 +22,19 @@ constexpr auto enum_table(SparseRefine) {
                     std::pair{SparseRefine::kWindowBa, "window_ba"}};
 }
 
+/// How step (iv)'s RANSAC ranks its hypotheses.
+enum class RansacScore {
+  kInliers,  ///< the most inliers (river paper, StereoScan)
+  /// MSAC (Torr and Zisserman 2000): the least sum over the matches of the squared
+  /// reprojection error truncated at the inlier threshold, so of two hypotheses with as many
+  /// inliers the one that fits them better wins.
+  kMsac,
+};
+constexpr auto enum_table(RansacScore) {
+  return std::array{std::pair{RansacScore::kInliers, "inliers"},
+                    std::pair{RansacScore::kMsac, "msac"}};
+}
+
 struct SparseVoOptions {
   // --- (i) detection: 5x5 blob and corner masks, non-maximum/-minimum suppression -------------
   // The masks themselves are fixed (StereoScan Fig. 3); they are not options.
@@ -63,8 +76,9 @@ struct SparseVoOptions {
   int max_features_per_bucket = 2;  // paper: "reduced to two"
 
   // --- (iv) estimation: RANSAC around Gauss-Newton on Eq. (2) ----------------------------------
-  int ransac_iterations = 50;  // paper: "50 times"
-  int ransac_sample_size = 3;  // paper: "three randomly-selected matches"
+  int ransac_iterations = 50;                        // paper: "50 times"
+  int ransac_sample_size = 3;                        // paper: "three randomly-selected matches"
+  RansacScore ransac_score = RansacScore::kInliers;  // paper: the most inliers
   // Ours (the paper states none; libviso2's default is 2 px, for integer matches with a parabola
   // fit): the Lucas-Kanade refined matches are good to about 0.05 px on rendered frames, and at
   // the river paper's 0.2 m/s and 8.2 Hz a feature 25 m away moves about 0.6 px a frame. Within
@@ -163,6 +177,10 @@ struct SparseVoOptions {
     a("ransac_sample_size", ransac_sample_size,
       "Matches drawn per RANSAC iteration (river paper: 3, the minimum for 6 DOF)",
       yaml::in_range(3, 64));
+    a("ransac_score", ransac_score,
+      "How RANSAC ranks its hypotheses: inliers, the most inliers (river paper); msac, the "
+      "least sum of squared reprojection errors truncated at inlier_threshold_px (Torr and "
+      "Zisserman 2000; a match's error is the larger of its left and right image's)");
     a("inlier_threshold_px", inlier_threshold_px,
       "Largest reprojection error, in the left and in the right image, of an inlier [px] (ours: "
       "the Lucas-Kanade refined matches are good to ~0.05 px; libviso2's default, 2 px, lets "

@@ -1,6 +1,7 @@
 #include "vo/sparse/stereo_motion.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -141,36 +142,80 @@ void StereoMotionEstimator::load(std::span<const StereoPointMatch> matches) {
   }
 }
 
+// The hot loop of RANSAC (iterations x matches projections), over the matches as structure of
+// arrays (X, Y, Z, u_l, v_l, u_r, v_r): no Eigen temporaries, squared distances.
+class StereoMotionEstimator::SquaredErrors {
+ public:
+  SquaredErrors(const StereoRig& rig, const SE3& T, const std::array<const double*, 7>& matches)
+      : R_(T.rotation()), t_(T.translation()), rig_(rig), m_(matches) {}
+
+  // Match i's squared reprojection errors in the left and the right image; false when the
+  // point is not in front.
+  bool operator()(int i, double* left2, double* right2) const {
+    const auto& [X, Y, Z, ul, vl, ur, vr] = m_;
+    const double x = R_(0, 0) * X[i] + R_(0, 1) * Y[i] + R_(0, 2) * Z[i] + t_.x();
+    const double y = R_(1, 0) * X[i] + R_(1, 1) * Y[i] + R_(1, 2) * Z[i] + t_.y();
+    const double z = R_(2, 0) * X[i] + R_(2, 1) * Y[i] + R_(2, 2) * Z[i] + t_.z();
+    if (!(z > kMinProjectionDepthM)) return false;
+    const PinholeCamera& c = rig_.camera;
+    const double inv_z = 1.0 / z;
+    const double du = ul[i] - (c.fx * x * inv_z + c.cx);
+    const double v = c.fy * y * inv_z + c.cy;
+    const double dvl = vl[i] - v;
+    const double dur = ur[i] - (c.fx * (x - rig_.baseline_m) * inv_z + c.cx);
+    const double dvr = vr[i] - v;
+    *left2 = du * du + dvl * dvl;
+    *right2 = dur * dur + dvr * dvr;
+    return true;
+  }
+
+ private:
+  Mat3 R_;
+  Vec3 t_;
+  const StereoRig& rig_;
+  std::array<const double*, 7> m_;
+};
+
+StereoMotionEstimator::SquaredErrors StereoMotionEstimator::squared_errors(
+    const SE3& T_curr_prev) const {
+  return SquaredErrors(
+      rig_, T_curr_prev,
+      {X_.data(), Y_.data(), Z_.data(), ul_.data(), vl_.data(), ur_.data(), vr_.data()});
+}
+
 int StereoMotionEstimator::collect_inliers(const SE3& T_curr_prev, int to_beat,
                                            std::vector<int>* out) const {
-  // The hot loop of RANSAC (iterations x matches projections): structure of arrays, no Eigen
-  // temporaries, squared distances. Gives up, returning -1, once even all remaining matches
-  // could not make more than to_beat inliers.
+  // Gives up, returning -1, once even all remaining matches could not make more than to_beat
+  // inliers.
   out->clear();
-  const Mat3 R = T_curr_prev.rotation();
-  const Vec3 t = T_curr_prev.translation();
-  const double r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2), r10 = R(1, 0), r11 = R(1, 1),
-               r12 = R(1, 2), r20 = R(2, 0), r21 = R(2, 1), r22 = R(2, 2);
-  const double tx = t.x(), ty = t.y(), tz = t.z();
-  const double fx = rig_.camera.fx, fy = rig_.camera.fy, cx = rig_.camera.cx, cy = rig_.camera.cy,
-               B = rig_.baseline_m;
   const double thr2 = options_.inlier_threshold_px * options_.inlier_threshold_px;
+  const SquaredErrors errors = squared_errors(T_curr_prev);
   const int n = static_cast<int>(X_.size());
+  double left2 = 0.0, right2 = 0.0;
   for (int i = 0; i < n; ++i) {
     if (static_cast<int>(out->size()) + (n - i) <= to_beat) return -1;
-    const double X = r00 * X_[i] + r01 * Y_[i] + r02 * Z_[i] + tx;
-    const double Y = r10 * X_[i] + r11 * Y_[i] + r12 * Z_[i] + ty;
-    const double Z = r20 * X_[i] + r21 * Y_[i] + r22 * Z_[i] + tz;
-    if (!(Z > kMinProjectionDepthM)) continue;
-    const double inv_z = 1.0 / Z;
-    const double du = ul_[i] - (fx * X * inv_z + cx);
-    const double v = fy * Y * inv_z + cy;
-    const double dvl = vl_[i] - v;
-    const double dur = ur_[i] - (fx * (X - B) * inv_z + cx);
-    const double dvr = vr_[i] - v;
-    if (du * du + dvl * dvl <= thr2 && dur * dur + dvr * dvr <= thr2) out->push_back(i);
+    if (errors(i, &left2, &right2) && left2 <= thr2 && right2 <= thr2) out->push_back(i);
   }
   return static_cast<int>(out->size());
+}
+
+double StereoMotionEstimator::msac_cost(const SE3& T_curr_prev, double to_beat) const {
+  // MSAC's cost (Torr and Zisserman 2000, Eq. 10): sum_i min(e_i^2, tau^2), e_i the larger of
+  // match i's left and right reprojection errors (the inlier test bounds both) and tau the
+  // inlier threshold. Gives up, returning infinity, once the sum reaches to_beat.
+  const double thr2 = options_.inlier_threshold_px * options_.inlier_threshold_px;
+  const SquaredErrors errors = squared_errors(T_curr_prev);
+  const int n = static_cast<int>(X_.size());
+  double cost = 0.0, left2 = 0.0, right2 = 0.0;
+  for (int i = 0; i < n && cost < to_beat; ++i)
+    cost += errors(i, &left2, &right2) ? std::min(std::max(left2, right2), thr2) : thr2;
+  return cost < to_beat ? cost : std::numeric_limits<double>::infinity();
+}
+
+double StereoMotionEstimator::msac_cost(std::span<const StereoPointMatch> matches,
+                                        const SE3& T_curr_prev) {
+  load(matches);
+  return msac_cost(T_curr_prev, std::numeric_limits<double>::infinity());
 }
 
 void StereoMotionEstimator::inliers(std::span<const StereoPointMatch> matches,
@@ -191,6 +236,9 @@ StereoMotionEstimator::Result StereoMotionEstimator::estimate(
   load(matches);
   best_.clear();
   SE3 best_T;
+  const bool msac = options_.ransac_score == RansacScore::kMsac;
+  double best_cost = std::numeric_limits<double>::infinity();
+  bool have_best = false;
   for (int it = 0; it < options_.ransac_iterations; ++it) {
     sample_.clear();
     while (static_cast<int>(sample_.size()) < s) {
@@ -199,13 +247,21 @@ StereoMotionEstimator::Result StereoMotionEstimator::estimate(
     }
     SE3 T = initial;
     if (!gauss_newton(matches, sample_, &T)) continue;
-    // Strictly more inliers wins, so the first of equally good hypotheses is kept.
-    if (collect_inliers(T, static_cast<int>(best_.size()), &candidate_) >
-        static_cast<int>(best_.size())) {
+    // Strictly better wins, so the first of equally good hypotheses is kept.
+    if (msac) {
+      const double cost = msac_cost(T, best_cost);
+      if (cost < best_cost) {
+        best_cost = cost;
+        best_T = T;
+        have_best = true;
+      }
+    } else if (collect_inliers(T, static_cast<int>(best_.size()), &candidate_) >
+               static_cast<int>(best_.size())) {
       best_.swap(candidate_);
       best_T = T;
     }
   }
+  if (msac && have_best) collect_inliers(best_T, -1, &best_);
   if (static_cast<int>(best_.size()) < options_.min_inliers) {
     result.failure =
         "too few inliers (" + std::to_string(best_.size()) + " of " + std::to_string(n) + ")";

@@ -58,6 +58,11 @@ class StereoMotionEstimator {
   void inliers(std::span<const StereoPointMatch> matches, const SE3& T_curr_prev,
                std::vector<int>* out);
 
+  /// MSAC's cost of T over the matches (ransac_score msac ranks hypotheses by it): the sum of
+  /// each match's squared reprojection error, the larger of its left and right image's,
+  /// truncated at inlier_threshold_px squared; a point not in front costs the truncation.
+  double msac_cost(std::span<const StereoPointMatch> matches, const SE3& T_curr_prev);
+
   struct Result {
     bool ok = false;
     std::string failure;                  ///< why not, when !ok
@@ -66,13 +71,17 @@ class StereoMotionEstimator {
   };
 
   /// RANSAC: ransac_iterations times, Gauss-Newton from `initial` (identity: no motion) on
-  /// ransac_sample_size matches drawn from `rng`; the iteration with the most inliers wins (the
-  /// first of equals), and with final_refinement Eq. (2) is minimised again over its inliers.
+  /// ransac_sample_size matches drawn from `rng`; the iteration with the most inliers (or with
+  /// ransac_score msac, the least truncated cost) wins (the first of equals), and with
+  /// final_refinement Eq. (2) is minimised again over its inliers.
   Result estimate(std::span<const StereoPointMatch> matches, Rng* rng, const SE3& initial = SE3());
 
  private:
   void load(std::span<const StereoPointMatch> matches);
+  class SquaredErrors;  // the loaded matches' squared reprojection errors under a motion
+  SquaredErrors squared_errors(const SE3& T_curr_prev) const;
   int collect_inliers(const SE3& T_curr_prev, int to_beat, std::vector<int>* out) const;
+  double msac_cost(const SE3& T_curr_prev, double to_beat) const;
 
   StereoRig rig_;
   SparseVoOptions options_;
