@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <xxhash.h>
 #include <zstd.h>
 
 #include "core/csv.hpp"
@@ -31,8 +32,13 @@ using Row = FrameCacheReader::Row;
 namespace {
 
 constexpr const char* kIndexHeader =
-    "k,exposure_ms,blur_samples,moving_px,width,height,left_bytes,left_fnv1a64,right_bytes,"
-    "right_fnv1a64";
+    "k,exposure_ms,blur_samples,moving_px,width,height,left_bytes,left_xxh3_64,right_bytes,"
+    "right_xxh3_64";
+
+// An image file's checksum: XXH3-64 (libxxhash), 19 times faster than FNV-1a 64 (16 GB/s against
+// 0.86, frame_cache_bench BM_FileChecksum), whose byte-by-byte loop was a tenth of a warm gate
+// job (every file is hashed twice: when the entry is found and as it is read).
+std::uint64_t file_hash(std::string_view bytes) { return XXH3_64bits(bytes.data(), bytes.size()); }
 
 // The whole file as bytes; false when it cannot be read.
 bool read_bytes(const fs::path& path, std::string* out) {
@@ -127,14 +133,14 @@ std::string parse_index(const std::string& text, std::vector<Row>* rows) {
   return "index.csv is truncated (no end row)";
 }
 
-// "" when `path` holds `bytes` bytes with FNV-1a 64 `hash` (then in *data), else what differs.
+// "" when `path` holds `bytes` bytes with checksum `hash` (then in *data), else what differs.
 std::string check_file(const fs::path& path, std::uint64_t bytes, std::uint64_t hash,
                        std::string* data) {
   if (!read_bytes(path, data)) return path.filename().string() + " is missing";
   if (data->size() != bytes)
     return fmt::format("{} has {} bytes, the index says {}", path.filename().string(), data->size(),
                        bytes);
-  if (fnv1a64(*data) != hash)
+  if (file_hash(*data) != hash)
     return path.filename().string() + " does not hold the bytes the index names";
   return "";
 }
@@ -235,9 +241,9 @@ void FrameCacheWriter::add(const CacheFrame& frame) {
   write_bytes(temp_ / frame_file(i, 'l'), left);
   write_bytes(temp_ / frame_file(i, 'r'), right);
   r.left_bytes = left.size();
-  r.left_hash = fnv1a64(left);
+  r.left_hash = file_hash(left);
   r.right_bytes = right.size();
-  r.right_hash = fnv1a64(right);
+  r.right_hash = file_hash(right);
   rows_.push_back(r);
 }
 

@@ -5,7 +5,7 @@
 //   key.txt     the key text itself, compared whole on every lookup (so two keys never share
 //               an entry, whatever their hashes);
 //   index.csv   one row per frame: k, exposure, blur samples, moving share, size, the length and
-//               FNV-1a 64 of each image file; a last row `end,N` (a truncated index has none);
+//               XXH3-64 of each image file; a last row `end,N` (a truncated index has none);
 //   NNNNNN_l.zst, NNNNNN_r.zst  the 8-bit rectified images, row by row, compressed by zstd
 //               (lossless).
 // An entry is filled in a folder of its own and published by one rename, so that a reader

@@ -143,7 +143,7 @@ std::string frame_cache_key(const std::string& identity, const Scenario& sc,
                             const sim::SceneGeometry& scene, const std::vector<FrameTruth>& truth,
                             const std::vector<sim::SampleTime>& stamps) {
   return fmt::format(
-      "driftlab frame cache key, version 3\n{}scene_fnv1a64 {}\ntruth_fnv1a64 {}\n"
+      "driftlab frame cache key, version 4\n{}scene_fnv1a64 {}\ntruth_fnv1a64 {}\n"
       "frames {}\n{}",
       identity, scene_fingerprint(scene), truth_fingerprint(truth, stamps), truth.size(),
       frame_deciding_yaml(sc));
