@@ -27,6 +27,7 @@
 #include "pipeline/sensor_stage.hpp"
 #include "pipeline/tracking.hpp"
 #include "pipeline/tracks.hpp"
+#include "pipeline/vo_pipeline.hpp"
 #include "pipeline/vo_stage.hpp"
 #include "report/run_report.hpp"
 #include "scenes/assets.hpp"
@@ -368,9 +369,13 @@ struct FrameLoop {
   std::vector<double>& moving_px;  // per frame (camera_gt's indices): CapturedFrame::moving_px
 };
 
-// The frame loop: every delivered frame through every track (the VOs, side by side when
-// `threads` >= 2, then the filters following them), a frames.csv row each, the exports for
-// the external VOs. Returns the render seconds.
+// Frames the VOs may be apart (pipeline/vo_pipeline.hpp): enough for the fast ones to run on
+// while the slow one takes a long frame; each is a stereo pair held in memory.
+constexpr std::size_t kVoLookahead = 4;
+
+// The frame loop: every delivered frame through every VO (each along its own frames, side by
+// side when `threads` >= 2), then, frame by frame in order, the filters following them, a
+// frames.csv row each, the exports for the external VOs. Returns the render seconds.
 double run_frame_loop(const FrameLoop& loop) {
   std::vector<Track>& tracks = loop.tracks;
   const std::filesystem::path& dir = loop.dir;
@@ -387,36 +392,46 @@ double run_frame_loop(const FrameLoop& loop) {
                     loop.options.progress_tty);
   const std::size_t sample_frame = camera_gt.size() / 2;  // drawn with its matches (Fig. 3)
   std::filesystem::create_directories(dir / "plots");
-  while (std::optional<CapturedFrame> captured = loop.source.next()) {
-    const std::size_t k = captured->k;  // dropped frames never come: nothing rendered or seen
-    progress.update(k);
-    loop.moving_px[k] = captured->moving_px;
-    const TimeNs t = loop.stamps[k].t_stamp_ns;  // what the camera's clock wrote
-    const double render_ms = captured->render_ms;
-    const double exposure_ms = captured->exposure_ms;
-    render_s += render_ms / 1000;
-    const sim::StereoImages& img = captured->images;
-    vo::StereoFrame frame;
-    frame.t_ns = t;
-    frame.left = cv_view(img.left);
-    frame.right = cv_view(img.right);
+  // One frame whose VOs are done: its row, the tracks' steps, its export.
+  auto finish_frame = [&](const VoJobDone& done) {
+    const std::size_t k = done.job.k;
+    const auto captured = std::static_pointer_cast<const CapturedFrame>(done.job.keep_alive);
+    const TimeNs t = done.job.frame.t_ns;
     std::string row = fmt::format("{},{},{},{},{:.3f},{},{},{}", t, rad2deg(platform[k].yaw_rad),
                                   rad2deg(platform[k].pitch_rad), rad2deg(platform[k].roll_rad),
-                                  render_ms, yaml::format_double(exposure_ms),
+                                  captured->render_ms, yaml::format_double(captured->exposure_ms),
                                   captured->blur_samples, yaml::format_double(captured->moving_px));
-    const std::vector<vo::VoResult> vo_results = process_vos(&tracks, frame, loop.threads);
     for (std::size_t i = 0; i < tracks.size(); ++i) {
       Track& tr = tracks[i];
-      const vo::VoResult& r = tr.vo ? vo_results[i] : tracks[tr.source].results[k];
-      if (k == sample_frame && tr.vo && r.valid && !tr.vo->last_matches().empty())
+      const vo::VoResult& r = tr.vo ? done.results[i] : tracks[tr.source].results[k];
+      if (k == sample_frame && tr.vo && r.valid && !done.matches[i].empty())
         cv::imwrite((dir / "plots" / (tr.name + "_matches.png")).string(),
-                    draw_matches(frame, tr.vo->last_matches()));
+                    draw_matches(done.job.frame, done.matches[i]));
       if (tr.vo) row += vo_csv_cells(r);
       advance_track(&tr, k, k == loop.first, t, r);
     }
     frames_csv.write(row + "\n");
-    loop.external.add_frame(t, img, camera_gt[k]);
+    loop.external.add_frame(t, captured->images, camera_gt[k]);
+  };
+  VoPipeline vos(&tracks, loop.threads, kVoLookahead);
+  while (std::optional<CapturedFrame> captured = loop.source.next()) {
+    const std::size_t k = captured->k;  // dropped frames never come: nothing rendered or seen
+    progress.update(k);
+    loop.moving_px[k] = captured->moving_px;
+    render_s += captured->render_ms / 1000;
+    auto held = std::make_shared<const CapturedFrame>(std::move(*captured));
+    VoJob job;
+    job.k = k;
+    job.frame.t_ns = loop.stamps[k].t_stamp_ns;  // what the camera's clock wrote
+    job.frame.left = cv_view(held->images.left);
+    job.frame.right = cv_view(held->images.right);
+    job.keep_alive = held;
+    job.keep_matches = k == sample_frame;
+    while (vos.full()) finish_frame(*vos.next_done(true));
+    vos.submit(std::move(job));
+    while (const std::optional<VoJobDone> done = vos.next_done(false)) finish_frame(*done);
   }
+  while (const std::optional<VoJobDone> done = vos.next_done(true)) finish_frame(*done);
   progress.update(camera_gt.size());
   progress.finish();
   frames_csv.commit();

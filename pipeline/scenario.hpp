@@ -126,9 +126,9 @@ struct PipelineOptions {
       yaml::non_negative());
     a("threads", threads,
       "Threads of the frame loop: 0 = every core; 1 = render and each VO in turn; 2 or more "
-      "= rendering on a thread of its own, up to 4 frames ahead, and the VOs of a frame side by "
-      "side, up to this many at a time (driftlab vo: the VOs only). The output bytes are the "
-      "same whatever the count",
+      "= rendering on a thread of its own, up to 4 frames ahead, and the VOs side by side, up "
+      "to this many at a time, each along its own frames up to 4 frames apart (driftlab vo: the "
+      "VOs of a frame side by side). The output bytes are the same whatever the count",
       yaml::in_range(0, 256));
     a("sparse", sparse, "Options of the sparse VO (river paper Section 2.3.1)");
     a("sparse_kf", sparse_kf,

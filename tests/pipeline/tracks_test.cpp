@@ -1,5 +1,7 @@
-// pipeline/tracks: the VOs of a frame side by side (process_vos).
+// pipeline/tracks: the VOs of a frame side by side (process_vos); pipeline/vo_pipeline: each VO
+// along its own frames (VoPipeline).
 #include "pipeline/tracks.hpp"
+#include "pipeline/vo_pipeline.hpp"
 
 #include <atomic>
 #include <chrono>
@@ -118,6 +120,86 @@ TEST(ProcessVos, AVosExceptionReachesTheCallerAfterTheOthersFinish) {
     // The VOs beside it completed their second frame before the exception came out.
     EXPECT_EQ(vo_of(tracks[0]).done(), 2) << threads;
     EXPECT_EQ(vo_of(tracks[3]).done(), threads == 1 ? 1 : 2) << threads;
+  }
+}
+
+VoJob job_at(std::size_t k) {
+  VoJob job;
+  job.k = k;
+  job.frame.t_ns = static_cast<TimeNs>(10 * (k + 1));
+  return job;
+}
+
+// Submits `frames` frames, taking out the oldest whenever the pipeline is full, then the rest.
+std::vector<VoJobDone> run_pipeline(VoPipeline* p, std::size_t frames) {
+  std::vector<VoJobDone> out;
+  for (std::size_t k = 0; k < frames; ++k) {
+    while (p->full()) out.push_back(*p->next_done(true));
+    p->submit(job_at(k));
+    while (auto d = p->next_done(false)) out.push_back(std::move(*d));
+  }
+  while (auto d = p->next_done(true)) out.push_back(std::move(*d));
+  return out;
+}
+
+TEST(VoPipeline, GivesTheResultsOfTheVosInTurnInFrameOrder) {
+  for (int threads : {1, 2, 3, 8}) {
+    std::vector<Track> serial = three_vos(), piped = three_vos();
+    std::vector<std::vector<vo::VoResult>> expected;
+    for (std::size_t k = 0; k < 7; ++k)
+      expected.push_back(process_vos(&serial, job_at(k).frame, 1));
+    std::vector<VoJobDone> got;
+    {
+      VoPipeline p(&piped, threads, 3);
+      got = run_pipeline(&p, 7);
+    }
+    ASSERT_EQ(got.size(), 7u) << threads;
+    for (std::size_t k = 0; k < 7; ++k) {
+      EXPECT_EQ(got[k].job.k, k);
+      ASSERT_EQ(got[k].results.size(), 4u);
+      for (std::size_t i = 0; i < 4; ++i) {
+        EXPECT_EQ(got[k].results[i].valid, expected[k][i].valid) << threads << " " << k << " " << i;
+        EXPECT_EQ(got[k].results[i].inliers, expected[k][i].inliers) << threads << " " << k;
+        EXPECT_EQ(got[k].results[i].T_prev_curr.translation(),
+                  expected[k][i].T_prev_curr.translation());
+      }
+    }
+    EXPECT_FALSE(piped[1].vo);  // the track without a VO is left alone
+    EXPECT_EQ(vo_of(piped[3]).done(), 7);
+  }
+}
+
+TEST(VoPipeline, TheFastVosRunAheadWhileTheSlowOneTakesItsFrame) {
+  // VO 1 takes 150 ms a frame, VOs 2 and 3 5 ms: on two workers, by the time VO 1 is done with
+  // frame 0 the other worker has run VOs 2 and 3 on the next frames (process_vos would hold them
+  // at frame 0 for 150 ms).
+  std::vector<Track> tracks(3);
+  tracks[0].vo = std::make_unique<RecordingVo>(1, 0, 150);
+  tracks[1].vo = std::make_unique<RecordingVo>(2, 0, 5);
+  tracks[2].vo = std::make_unique<RecordingVo>(3, 0, 5);
+  tracks[0].vo_ms = 100;  // the slowest so far: taken first
+  VoPipeline p(&tracks, 2, 4);
+  for (std::size_t k = 0; k < 4; ++k) p.submit(job_at(k));
+  EXPECT_TRUE(p.full());
+  const std::optional<VoJobDone> first = p.next_done(true);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->job.k, 0u);
+  EXPECT_GE(vo_of(tracks[1]).done(), 3);
+  EXPECT_GE(vo_of(tracks[2]).done(), 3);
+  EXPECT_EQ(vo_of(tracks[0]).done(), 1);
+}
+
+TEST(VoPipeline, AVosExceptionReachesTheCaller) {
+  for (int threads : {1, 2}) {
+    std::vector<Track> tracks = three_vos(/*throw_on_of_second=*/3);
+    VoPipeline p(&tracks, threads, 2);
+    try {
+      run_pipeline(&p, 6);
+      FAIL() << "expected the second VO's UserError";
+    } catch (const UserError& e) {
+      EXPECT_STREQ(e.what(), "vo 2 failed");
+    }
+    EXPECT_THROW(p.submit(job_at(9)), UserError) << "and from every call after it";
   }
 }
 

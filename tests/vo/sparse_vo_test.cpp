@@ -12,6 +12,7 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <set>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -656,13 +657,41 @@ TEST(SparseVoTest, SharedDetectionComparesTheImagesBytes) {
   EXPECT_NE(first.get(), changed.get());
   EXPECT_EQ(shared.detected(), 2);
   EXPECT_EQ(shared.shared(), 1);
-  // A pair nobody holds any more is refilled for the next one, not reallocated.
-  const sparse::PairFeatures* released = first.get();
+  // Pairs nobody holds any more are refilled for the next ones once kRecentPairs newer pairs
+  // came, not reallocated: 3 x kRecentPairs new pairs, none held, in at most kRecentPairs + 1
+  // buffers.
   first.reset();
   again.reset();
-  const auto next = shared.get(seq.frames[1].left, seq.frames[1].right, &detector).features;
-  EXPECT_EQ(next.get(), released);
-  EXPECT_EQ(shared.detected(), 3);
+  std::set<const sparse::PairFeatures*> buffers;
+  constexpr std::size_t kRecent = sparse::SharedDetection::kRecentPairs;
+  for (std::size_t i = 0; i < 3 * kRecent; ++i) {
+    left.at<std::uint8_t>(200, 10 + static_cast<int>(i)) ^= 0x40;
+    buffers.insert(shared.get(left, right, &detector).features.get());
+  }
+  EXPECT_LE(buffers.size(), kRecent + 1);
+  EXPECT_EQ(shared.detected(), 2 + 3 * static_cast<long>(kRecent));
+}
+
+// VOs that run frames apart (pipeline/vo_pipeline.hpp) still share: the last kRecentPairs
+// pairs are kept for a caller that comes later.
+TEST(SparseVoTest, SharedDetectionServesACallerSomeFramesBehind) {
+  const test::Sequence& seq = short_640();
+  const SparseVoOptions o;
+  sparse::SharedDetection shared(sparse::detection_settings(o));
+  sparse::PairDetector detector(seq.rig.camera.width, seq.rig.camera.height, o);
+  std::vector<cv::Mat> lefts;
+  for (std::size_t i = 0; i < sparse::SharedDetection::kRecentPairs; ++i) {
+    lefts.push_back(seq.frames[0].left.clone());
+    lefts.back().at<std::uint8_t>(50, 50 + static_cast<int>(i)) ^= 0x40;
+  }
+  std::vector<const sparse::PairFeatures*> ahead;
+  for (const cv::Mat& l : lefts)
+    ahead.push_back(shared.get(l, seq.frames[0].right, &detector).features.get());
+  for (std::size_t i = 0; i < lefts.size(); ++i)
+    EXPECT_EQ(shared.get(lefts[i].clone(), seq.frames[0].right, &detector).features.get(), ahead[i])
+        << i;
+  EXPECT_EQ(shared.detected(), static_cast<long>(lefts.size()));
+  EXPECT_EQ(shared.shared(), static_cast<long>(lefts.size()));
 }
 
 TEST(SparseVoTest, SingleStageMatchingTracksToo) {

@@ -2,6 +2,7 @@
 
 #include <opencv2/video/tracking.hpp>
 
+#include <algorithm>
 #include <cstring>
 #include <exception>
 #include <utility>
@@ -47,7 +48,8 @@ std::shared_ptr<SharedDetection::Entry> SharedDetection::free_entry() {
   // An entry only the pool holds is free: entries are handed out under mutex_ alone, so no
   // other thread can take one between this check and its reuse.
   for (auto& e : pool_)
-    if (e.use_count() == 1 && e != latest_) return e;
+    if (e.use_count() == 1 && std::find(recent_.begin(), recent_.end(), e) == recent_.end())
+      return e;
   pool_.push_back(std::make_shared<Entry>());
   return pool_.back();
 }
@@ -60,15 +62,19 @@ SharedDetection::Got SharedDetection::get(const cv::Mat& left, const cv::Mat& ri
   bool mine = false;
   {
     std::lock_guard lock(mutex_);
-    if (latest_ && same_image(left, latest_->left) && same_image(right, latest_->right)) {
-      entry = latest_;
+    const auto found = std::find_if(recent_.begin(), recent_.end(), [&](const auto& e) {
+      return same_image(left, e->left) && same_image(right, e->right);
+    });
+    if (found != recent_.end()) {
+      entry = *found;
       ++shared_;
     } else {
       entry = free_entry();
       left.copyTo(entry->left);
       right.copyTo(entry->right);
       entry->done = promise.get_future().share();
-      latest_ = entry;
+      recent_.push_front(entry);
+      if (recent_.size() > kRecentPairs) recent_.pop_back();
       mine = true;
       ++detected_;
     }
@@ -80,7 +86,7 @@ SharedDetection::Got SharedDetection::get(const cv::Mat& left, const cv::Mat& ri
     } catch (...) {
       promise.set_exception(std::current_exception());
       std::lock_guard lock(mutex_);
-      if (latest_ == entry) latest_.reset();
+      recent_.erase(std::remove(recent_.begin(), recent_.end(), entry), recent_.end());
       throw;
     }
     promise.set_value();

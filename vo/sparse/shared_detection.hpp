@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <deque>
 #include <future>
 #include <memory>
 #include <mutex>
@@ -50,12 +51,17 @@ class PairDetector {
   DetectionSettings settings_;
 };
 
-/// The latest pair's features for every VO that asks for the same images; thread-safe (a run's
-/// VOs process a frame side by side). The first caller for a pair detects it; a caller with the
-/// same images (compared byte for byte) waits for that result. Results live as long as a VO
-/// holds them (the reference pair); pairs nobody holds any more are refilled, not reallocated.
+/// The latest pairs' features for every VO that asks for the same images; thread-safe (a run's
+/// VOs process frames side by side, each VO at its own frame: pipeline/vo_pipeline.hpp). The
+/// first caller for a pair detects it; a caller with the same images (compared byte for byte)
+/// waits for that result. The last kRecentPairs pairs are kept for callers that come later;
+/// results live as long as a VO holds them (the reference pair); pairs nobody holds any more
+/// are refilled, not reallocated.
 class SharedDetection {
  public:
+  /// Pairs kept for later callers: more than the frames a run's VOs may be apart
+  /// (pipeline/vo_pipeline.hpp's lookahead).
+  static constexpr std::size_t kRecentPairs = 8;
   explicit SharedDetection(const DetectionSettings& settings) : settings_(settings) {}
   const DetectionSettings& settings() const { return settings_; }
 
@@ -81,7 +87,7 @@ class SharedDetection {
   DetectionSettings settings_;
   mutable std::mutex mutex_;
   std::vector<std::shared_ptr<Entry>> pool_;
-  std::shared_ptr<Entry> latest_;
+  std::deque<std::shared_ptr<Entry>> recent_;  // newest first
   long detected_ = 0, shared_ = 0;
 };
 
