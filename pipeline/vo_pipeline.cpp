@@ -7,6 +7,16 @@
 
 namespace driftlab::pipeline {
 
+namespace {
+
+// A VO's matches on the frame it processed last, copied out of its buffers.
+std::vector<vo::MatchInfo> matches_of(const vo::StereoOdometry& vo) {
+  const auto m = vo.last_matches();
+  return {m.begin(), m.end()};
+}
+
+}  // namespace
+
 VoPipeline::VoPipeline(std::vector<Track>* tracks, int threads, std::size_t lookahead)
     : tracks_(*tracks), lookahead_(std::max<std::size_t>(lookahead, 1)), serial_(threads <= 1) {
   for (std::size_t i = 0; i < tracks_.size(); ++i)
@@ -58,10 +68,7 @@ void VoPipeline::work() {
     std::vector<vo::MatchInfo> matches;
     try {
       r = track.vo->process(slot.job.frame);
-      if (slot.job.keep_matches) {
-        const auto m = track.vo->last_matches();
-        matches.assign(m.begin(), m.end());
-      }
+      if (slot.job.keep_matches) matches = matches_of(*track.vo);
     } catch (...) {
       error = std::current_exception();
     }
@@ -96,10 +103,7 @@ void VoPipeline::submit(VoJob job) {
     }
     slot.matches.resize(tracks_.size());
     if (job.keep_matches)
-      for (const std::size_t i : vos_) {
-        const auto m = tracks_[i].vo->last_matches();
-        slot.matches[i].assign(m.begin(), m.end());
-      }
+      for (const std::size_t i : vos_) slot.matches[i] = matches_of(*tracks_[i].vo);
     slot.job = std::move(job);
     const std::lock_guard lock(mutex_);
     slots_.push_back(std::move(slot));
