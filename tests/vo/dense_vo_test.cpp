@@ -381,6 +381,26 @@ TEST(DenseDisparityTest, RefinementDropsMatchesTheRightImageDoesNotConfirm) {
   EXPECT_LT(checked, 100);
 }
 
+TEST(DenseDisparityTest, RefinementInLanesGivesTheBytesOfThePlainLoop) {
+  // The refinement's row loops run four pixels at a time with a plain loop for the rest of a
+  // row; on a pair 638 px wide (two pixels left over per row) both give the plain loop's bytes.
+  const Sequence& seq = dense_straight_640();
+  const cv::Rect crop(0, 0, 638, seq.rig.camera.height);
+  const cv::Mat left = seq.frames[1].left(crop).clone(), right = seq.frames[1].right(crop).clone();
+  cv::Mat left_f;
+  left.convertTo(left_f, CV_32F);
+  const dense::DisparityOptions o = dense::disparity_options(DenseVoOptions{});
+  ASSERT_GT(o.refine_iterations, 0);
+  cv::Mat lanes, plain;
+  dense::DisparityEstimator(o, dense::DisparityEstimator::Lanes::kSimd)
+      .compute(left, right, left_f, &lanes);
+  dense::DisparityEstimator(o, dense::DisparityEstimator::Lanes::kScalar)
+      .compute(left, right, left_f, &plain);
+  ASSERT_EQ(lanes.size(), plain.size());
+  EXPECT_GT(cv::countNonZero(plain > 0.0f), crop.area() / 2);
+  EXPECT_EQ(std::memcmp(lanes.data, plain.data, lanes.total() * lanes.elemSize()), 0);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Accuracy: the pyramid, the paper's method and the extensions
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.hpp"
@@ -29,7 +30,8 @@ int searched_disparities(const DisparityOptions& options) {
   return (per_level + 15) / 16 * 16;
 }
 
-DisparityEstimator::DisparityEstimator(const DisparityOptions& options) : options_(options) {
+DisparityEstimator::DisparityEstimator(const DisparityOptions& options, Lanes lanes)
+    : options_(options), simd_(lanes == Lanes::kSimd) {
   if (options.downsample < 1)
     throw InternalError("DisparityEstimator: downsample must be at least 1");
   sgbm_ = cv::StereoSGBM::create(
@@ -71,58 +73,140 @@ void DisparityEstimator::compute(const cv::Mat& left8, const cv::Mat& right8,
   refine(left_f32, disparity);
 }
 
-void DisparityEstimator::linearise(const cv::Mat& left_f32, const cv::Mat& disparity) {
-  const int W = disparity.cols, H = disparity.rows;
-  ge_.create(H, W, CV_32FC1);
-  gg_.create(H, W, CV_32FC1);
-  ee_.create(H, W, CV_32FC1);
-  for_each_row(H, [&](int v) {
-    const float* d = disparity.ptr<float>(v);
-    const float* L = left_f32.ptr<float>(v);
-    const float* R = right_f32_.ptr<float>(v);
-    const float* G = right_dx_.ptr<float>(v);
-    float* ge = ge_.ptr<float>(v);
-    float* gg = gg_.ptr<float>(v);
-    float* ee = ee_.ptr<float>(v);
-    for (int u = 0; u < W; ++u) {
-      const float x = static_cast<float>(u) - d[u];
-      if (!(d[u] > 0.0f) || !(x >= 0.0f) || !(x < static_cast<float>(W - 1))) {
-        ge[u] = gg[u] = ee[u] = 0.0f;
-        continue;
-      }
-      const int x0 = static_cast<int>(x);
-      const float a = x - static_cast<float>(x0);
-      const float rw = (1.0f - a) * R[x0] + a * R[x0 + 1];
-      const float g = (1.0f - a) * G[x0] + a * G[x0 + 1];
-      const float e = L[u] - rw;
+namespace {
+
+// The right image at x = u - d for the pixels u of a row with disparity d: the residual
+// e = L(u) - R(x) and the slope g = dR/dx(x), both linear in x; 0 for both without a disparity
+// or outside the right image (x is then clamped to 0 to read something).
+struct RowSampler {
+  const float* L;
+  const float* R;
+  const float* G;
+  int W;
+  void operator()(int u, float d, float* e, float* g) const {
+    const float x = static_cast<float>(u) - d;
+    const bool ok = d > 0.0f && x >= 0.0f && x < static_cast<float>(W - 1);
+    const float xs = ok ? x : 0.0f;
+    const int x0 = static_cast<int>(xs);
+    const float a = xs - static_cast<float>(x0), b = 1.0f - a;
+    const float ev = L[u] - (b * R[x0] + a * R[x0 + 1]);
+    const float gv = b * G[x0] + a * G[x0 + 1];
+    *e = ok ? ev : 0.0f;
+    *g = ok ? gv : 0.0f;
+  }
+};
+
+}  // namespace
+
+#if CV_SIMD128
+namespace {
+
+// RowSampler on the four pixels from u (OpenCV's universal intrinsics): the same operations in
+// the same order, lane by lane, so the same bytes.
+struct RowSampler4 {
+  RowSampler s;
+  void operator()(int u, const float* d, cv::v_float32x4* e, cv::v_float32x4* g) const {
+    const cv::v_float32x4 zero = cv::v_setzero_f32(), one = cv::v_setall_f32(1.0f);
+    const cv::v_float32x4 vd = cv::v_load(d + u);
+    const cv::v_float32x4 x = cv::v_cvt_f32(cv::v_int32x4(u, u + 1, u + 2, u + 3)) - vd;
+    const cv::v_float32x4 ok =
+        (vd > zero) & (x >= zero) & (x < cv::v_setall_f32(static_cast<float>(s.W - 1)));
+    const cv::v_float32x4 xs = cv::v_select(ok, x, zero);
+    const cv::v_int32x4 x0 = cv::v_trunc(xs);
+    const cv::v_float32x4 a = xs - cv::v_cvt_f32(x0), b = one - a;
+    const cv::v_float32x4 ev =
+        cv::v_load(s.L + u) - (b * cv::v_lut(s.R, x0) + a * cv::v_lut(s.R + 1, x0));
+    const cv::v_float32x4 gv = b * cv::v_lut(s.G, x0) + a * cv::v_lut(s.G + 1, x0);
+    *e = cv::v_select(ok, ev, zero);
+    *g = cv::v_select(ok, gv, zero);
+  }
+};
+
+}  // namespace
+#endif
+
+void DisparityEstimator::linearise_row(const cv::Mat& left_f32, const cv::Mat& disparity, int v,
+                                       bool slopes) {
+  const RowSampler sample{left_f32.ptr<float>(v), right_f32_.ptr<float>(v), right_dx_.ptr<float>(v),
+                          disparity.cols};
+  const float* d = disparity.ptr<float>(v);
+  float* ge = ge_.ptr<float>(v);
+  float* gg = gg_.ptr<float>(v);
+  float* ee = ee_.ptr<float>(v);
+  int u = 0;
+#if CV_SIMD128
+  const RowSampler4 sample4{sample};
+  for (; simd_ && u + 4 <= disparity.cols; u += 4) {
+    cv::v_float32x4 e, g;
+    sample4(u, d, &e, &g);
+    if (slopes) {
+      cv::v_store(ge + u, g * e);
+      cv::v_store(gg + u, g * g);
+    } else {
+      cv::v_store(ee + u, e * e);
+    }
+  }
+#endif
+  for (; u < disparity.cols; ++u) {
+    float e, g;
+    sample(u, d[u], &e, &g);
+    if (slopes) {
       ge[u] = g * e;
       gg[u] = g * g;
+    } else {
       ee[u] = e * e;
     }
-  });
+  }
 }
+
+namespace {
+
+// One Lucas-Kanade step on a row of disparities d from the window sums of g e and g^2: d += the
+// clamped correction where d > 0 and the window has gradient energy above min_energy.
+void step_row(const float* sge, const float* sgg, float min_energy, int W, bool simd, float* d) {
+  static_cast<void>(simd);  // unused without SIMD
+  int u = 0;
+#if CV_SIMD128
+  const cv::v_float32x4 zero = cv::v_setzero_f32(), minus_one = cv::v_setall_f32(-1.0f);
+  const cv::v_float32x4 lo = cv::v_setall_f32(-0.5f), hi = cv::v_setall_f32(0.5f);
+  const cv::v_float32x4 min_e = cv::v_setall_f32(min_energy);
+  for (; simd && u + 4 <= W; u += 4) {
+    const cv::v_float32x4 vd = cv::v_load(d + u), vgg = cv::v_load(sgg + u);
+    const cv::v_float32x4 ratio = (minus_one * cv::v_load(sge + u)) / vgg;
+    const cv::v_float32x4 step = cv::v_min(cv::v_max(ratio, lo), hi);
+    cv::v_store(d + u, cv::v_select((vd > zero) & (vgg > min_e), vd + step, vd));
+  }
+#endif
+  for (; u < W; ++u) {
+    if (!(d[u] > 0.0f) || !(sgg[u] > min_energy)) continue;
+    d[u] += std::clamp(-sge[u] / sgg[u], -0.5f, 0.5f);
+  }
+}
+
+}  // namespace
 
 void DisparityEstimator::refine(const cv::Mat& left_f32, cv::Mat* disparity) {
   const int W = disparity->cols, H = disparity->rows;
+  ge_.create(H, W, CV_32FC1);
+  gg_.create(H, W, CV_32FC1);
+  ee_.create(H, W, CV_32FC1);
   // Windows with less gradient energy than 1 grey/px on every pixel keep SGBM's value.
   const float min_energy = static_cast<float>(options_.refine_window * options_.refine_window);
-  for (int it = 0; it < options_.refine_iterations; ++it) {
-    linearise(left_f32, *disparity);
+  const int iterations = options_.refine_iterations;
+  for_each_row(H, [&](int v) { linearise_row(left_f32, *disparity, v, /*slopes=*/true); });
+  for (int it = 0; it < iterations; ++it) {
     box_filter(ge_, &ge_sum_, options_.refine_window, false);
     box_filter(gg_, &gg_sum_, options_.refine_window, false);
+    // A row's step reads its own sums only: each row is stepped, then linearised at its new
+    // disparity for the next iteration (slopes) or the acceptance below (residuals).
     for_each_row(H, [&](int v) {
-      float* d = disparity->ptr<float>(v);
-      const float* sge = ge_sum_.ptr<float>(v);
-      const float* sgg = gg_sum_.ptr<float>(v);
-      for (int u = 0; u < W; ++u) {
-        if (!(d[u] > 0.0f) || !(sgg[u] > min_energy)) continue;
-        d[u] += std::clamp(-sge[u] / sgg[u], -0.5f, 0.5f);
-      }
+      step_row(ge_sum_.ptr<float>(v), gg_sum_.ptr<float>(v), min_energy, W, simd_,
+               disparity->ptr<float>(v));
+      linearise_row(left_f32, *disparity, v, /*slopes=*/it + 1 < iterations);
     });
   }
   // A match is kept when the refinement moved it little and the refined disparity brings the
   // window's right-image pixels onto the left ones (RMS residual within max_residual).
-  linearise(left_f32, *disparity);
   box_filter(ee_, &ee_mean_, options_.refine_window, true);
   const float max_change = static_cast<float>(options_.refine_max_change);
   const float max_ee =

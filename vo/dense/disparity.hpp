@@ -40,7 +40,11 @@ int searched_disparities(const DisparityOptions& options);
 /// SGBM plus refinement, with buffers kept between calls. Not thread-safe.
 class DisparityEstimator {
  public:
-  explicit DisparityEstimator(const DisparityOptions& options);
+  /// kSimd: the refinement's row loops four pixels at a time (OpenCV's universal intrinsics)
+  /// where the build has them; kScalar: one at a time. Both give the same bytes (tests compare).
+  enum class Lanes { kSimd, kScalar };
+
+  explicit DisparityEstimator(const DisparityOptions& options, Lanes lanes = Lanes::kSimd);
 
   /// Disparity of the left image [px], CV_32FC1; 0 where SGBM found none. `left_f32` is the
   /// left image as CV_32FC1 (the pyramid's finest level), used by the refinement only.
@@ -52,15 +56,17 @@ class DisparityEstimator {
   // and e = L - R_w, minimise sum_window (e + dR/dx(x - d) delta)^2 over delta; the sums are box
   // filters, so an iteration costs a few passes over the image whatever the window.
   void refine(const cv::Mat& left_f32, cv::Mat* disparity);
-  /// Per pixel at the given disparity, with e = L - R_w and g = dR/dx(x - d): g e into ge_, g^2
-  /// into gg_ and e^2 into ee_ (zeros without a disparity or outside the right image).
-  void linearise(const cv::Mat& left_f32, const cv::Mat& disparity);
+  /// Per pixel of row v at the given disparity, with e = L - R_w and g = dR/dx(x - d): g e into
+  /// ge_ and g^2 into gg_ (slopes) or e^2 into ee_ (zeros without a disparity or outside the
+  /// right image).
+  void linearise_row(const cv::Mat& left_f32, const cv::Mat& disparity, int v, bool slopes);
 
   /// SGBM on the (possibly shrunk) pair, written as full-resolution disparity [px] with 0 where
   /// SGBM found none.
   void match(const cv::Mat& left8, const cv::Mat& right8, cv::Mat* disparity);
 
   DisparityOptions options_;
+  bool simd_ = true;
   cv::Ptr<cv::StereoSGBM> sgbm_;
   cv::Mat small_left_, small_right_, small_disparity_;
   cv::Mat raw_, sgbm_disparity_, right_f32_, right_dx_, ge_, gg_, ee_, ge_sum_, gg_sum_, ee_mean_;
