@@ -96,11 +96,11 @@ void cover(int level_size, int full_size, double s, std::vector<int>* first,
   }
 }
 
-// Appends the reference pixel (u, v) of a level with gradient (gx, gy), intensity i and
-// disparity D [full-resolution px]: its point by Eq. (1) and its Jacobian row, the expanded
-// photometric_jacobian() in float.
-inline void add_point(float u, float v, float gx, float gy, float i, float D, const LevelCamera& c,
-                      float baseline_fx, RefLevel* out) {
+// Writes the reference pixel (u, v) of a level with gradient (gx, gy), intensity i and
+// disparity D [full-resolution px] as point k of `out`: its point by Eq. (1) and its Jacobian
+// row, the expanded photometric_jacobian() in float.
+inline void set_point(std::size_t k, float u, float v, float gx, float gy, float i, float D,
+                      const LevelCamera& c, float baseline_fx, RefLevel* out) {
   // Eq. (1): Z = f B / D, X = Z (p_x - c_x) / f, Y = Z (p_y - c_y) / f (level intrinsics).
   const float Z = baseline_fx / D;
   const float X = Z * (u - static_cast<float>(c.cx)) / static_cast<float>(c.fx);
@@ -108,20 +108,26 @@ inline void add_point(float u, float v, float gx, float gy, float i, float D, co
   const float iz = 1.0f / Z;
   const float a = gx * static_cast<float>(c.fx) * iz, b = gy * static_cast<float>(c.fy) * iz;
   const float cz = -(a * X + b * Y) * iz;
-  out->points.push_back({X, Y, Z, i});
-  out->jacobians.push_back({{a, b, cz, Y * cz - Z * b, Z * a - X * cz, X * b - Y * a, 0.0f, 0.0f}});
+  out->points[k] = {X, Y, Z, i};
+  out->jacobians[k] = {{a, b, cz, Y * cz - Z * b, Z * a - X * cz, X * b - Y * a, 0.0f, 0.0f}};
 }
 
-}  // namespace
+// The central-difference gradient of level image I at (u, v).
+inline void gradient(const cv::Mat& I, int u, int v, float* gx, float* gy) {
+  const float* row = I.ptr<float>(v);
+  *gx = 0.5f * (row[u + 1] - row[u - 1]);
+  *gy = 0.5f * (I.ptr<float>(v + 1)[u] - I.ptr<float>(v - 1)[u]);
+}
 
-namespace {
+// Whether a full-resolution pixel of a row above v_end becomes a reference point.
+inline bool kept(const RefSelection& selection, float d, float min_d, std::uint8_t textured) {
+  return d >= min_d && (!selection.gradient_mask || textured != 0);
+}
 
-// The full-resolution pixels of rows [v0, v1) (1 <= v0, v1 <= H - 1) into `sel`: the texture mask,
-// the frame's texture counts and the points of rows above v_end.
-void select_full_rows(const Pyramid& pyramid, const cv::Mat& disparity, float fB,
-                      const RefSelection& selection, int v_end, int v0, int v1, cv::Mat* textured,
-                      RowsSelected* sel) {
-  const LevelCamera& c = pyramid.cameras.back();
+// The first pass over the full-resolution rows [v0, v1) (1 <= v0, v1 <= H - 1): the texture mask
+// and, per row, its textured pixels, those of them with depth and the points it will give.
+void count_full_rows(const Pyramid& pyramid, const cv::Mat& disparity,
+                     const RefSelection& selection, int v_end, int v0, int v1, Reference* ref) {
   const cv::Mat& I = pyramid.images.back();
   const int W = disparity.cols;
   const float min_d = static_cast<float>(selection.min_disparity_px);
@@ -131,49 +137,66 @@ void select_full_rows(const Pyramid& pyramid, const cv::Mat& disparity, float fB
     const float* up = I.ptr<float>(v - 1);
     const float* down = I.ptr<float>(v + 1);
     const float* d = disparity.ptr<float>(v);
-    std::uint8_t* mask = textured->ptr<std::uint8_t>(v);
+    std::uint8_t* mask = ref->textured.ptr<std::uint8_t>(v);
     mask[0] = mask[W - 1] = 0;
-    const bool in_rows = v < v_end;
+    int textured = 0, both = 0, points = 0;
     for (int u = 1; u < W - 1; ++u) {
       const float gx = 0.5f * (row[u + 1] - row[u - 1]);
       const float gy = 0.5f * (down[u] - up[u]);
-      const bool is_textured = gx * gx + gy * gy >= g2_textured;
-      const bool has_depth = d[u] >= min_d;
-      mask[u] = is_textured ? 1 : 0;
-      sel->textured += is_textured ? 1 : 0;
-      sel->both += is_textured && has_depth ? 1 : 0;
-      if (!in_rows || !has_depth || (selection.gradient_mask && !is_textured)) continue;
-      add_point(static_cast<float>(u), static_cast<float>(v), gx, gy, row[u], d[u], c, fB,
-                &sel->level);
-      sel->level.textured.push_back(is_textured ? 1 : 0);
+      const std::uint8_t is_textured = gx * gx + gy * gy >= g2_textured ? 1 : 0;
+      mask[u] = is_textured;
+      textured += is_textured;
+      both += is_textured & (d[u] >= min_d ? 1 : 0);
+      points += kept(selection, d[u], min_d, is_textured) ? 1 : 0;
     }
+    const std::size_t r = static_cast<std::size_t>(v);
+    ref->row_textured[r] = textured;
+    ref->row_both[r] = both;
+    ref->row_points[r] = v < v_end ? points : 0;
   }
 }
 
-// The pixels of rows [v0, v1) of coarse level l into `sel`: those whose full-resolution block
-// has depth everywhere (and, with the mask, texture on half of it), at the block's mean
-// disparity.
-void select_coarse_rows(const Pyramid& pyramid, std::size_t l, const cv::Mat& disparity, float fB,
-                        const RefSelection& selection, const Reference& ref, int v0, int v1,
-                        RowsSelected* sel) {
+// The second pass over a full-resolution row v: its points from point k on.
+void write_full_row(const Pyramid& pyramid, const cv::Mat& disparity, float fB,
+                    const RefSelection& selection, const Reference& ref, int v, std::size_t k,
+                    RefLevel* level) {
+  const LevelCamera& c = pyramid.cameras.back();
+  const cv::Mat& I = pyramid.images.back();
+  const float min_d = static_cast<float>(selection.min_disparity_px);
+  const float* d = disparity.ptr<float>(v);
+  const std::uint8_t* mask = ref.textured.ptr<std::uint8_t>(v);
+  for (int u = 1; u < disparity.cols - 1; ++u) {
+    if (!kept(selection, d[u], min_d, mask[u])) continue;
+    float gx, gy;
+    gradient(I, u, v, &gx, &gy);
+    level->textured[k] = mask[u];
+    set_point(k++, static_cast<float>(u), static_cast<float>(v), gx, gy, I.ptr<float>(v)[u], d[u],
+              c, fB, level);
+  }
+}
+
+// The first pass over rows [v0, v1) of coarse level l: a pixel is kept when its full-resolution
+// block has depth everywhere (and, with the mask, texture on half of it); its disparity, the
+// block's mean, goes into ref->level_disparity (NaN: not kept), and each row's count into
+// ref->row_points.
+void count_coarse_rows(const Pyramid& pyramid, std::size_t l, const cv::Mat& disparity,
+                       const RefSelection& selection, int v0, int v1, Reference* ref) {
   const LevelCamera& c = pyramid.cameras[l];
-  const cv::Mat& I = pyramid.images[l];
   const float min_d = static_cast<float>(selection.min_disparity_px);
   for (int v = v0; v < v1; ++v) {
-    const float* row = I.ptr<float>(v);
-    const float* up = I.ptr<float>(v - 1);
-    const float* down = I.ptr<float>(v + 1);
-    const int r0 = ref.row_first[static_cast<std::size_t>(v)];
-    const int r1 = ref.row_last[static_cast<std::size_t>(v)];
+    const int r0 = ref->row_first[static_cast<std::size_t>(v)];
+    const int r1 = ref->row_last[static_cast<std::size_t>(v)];
+    float* out = ref->level_disparity.ptr<float>(v);
+    int points = 0;
     for (int u = 1; u < c.width - 1; ++u) {
-      const int c0 = ref.col_first[static_cast<std::size_t>(u)];
-      const int c1 = ref.col_last[static_cast<std::size_t>(u)];
+      const int c0 = ref->col_first[static_cast<std::size_t>(u)];
+      const int c1 = ref->col_last[static_cast<std::size_t>(u)];
       float sum = 0.0f;
       int n_textured = 0;
       bool all_valid = true;
       for (int y = r0; y <= r1 && all_valid; ++y) {
         const float* d = disparity.ptr<float>(y);
-        const std::uint8_t* mask = ref.textured.ptr<std::uint8_t>(y);
+        const std::uint8_t* mask = ref->textured.ptr<std::uint8_t>(y);
         for (int x = c0; x <= c1; ++x) {
           if (!(d[x] >= min_d)) {
             all_valid = false;
@@ -184,28 +207,57 @@ void select_coarse_rows(const Pyramid& pyramid, std::size_t l, const cv::Mat& di
         }
       }
       const int n = (r1 - r0 + 1) * (c1 - c0 + 1);
-      if (!all_valid || (selection.gradient_mask && 2 * n_textured < n)) continue;
-      const float gx = 0.5f * (row[u + 1] - row[u - 1]);
-      const float gy = 0.5f * (down[u] - up[u]);
-      add_point(static_cast<float>(u), static_cast<float>(v), gx, gy, row[u],
-                sum / static_cast<float>(n), c, fB, &sel->level);
+      const bool keep = all_valid && !(selection.gradient_mask && 2 * n_textured < n);
+      out[u] = keep ? sum / static_cast<float>(n) : std::numeric_limits<float>::quiet_NaN();
+      points += keep ? 1 : 0;
     }
+    ref->row_points[static_cast<std::size_t>(v)] = points;
   }
 }
 
-// Rows [first, last) of a level selected in pieces on OpenCV's threads, each piece into its own
-// scratch, then appended in row order: the points of a serial pass, in its order.
-template <class Select>
-void select_rows(int first, int last, Reference* ref, RefLevel* level, const Select& select) {
-  std::vector<RowsSelected>& pieces = ref->pieces;
-  pieces.resize(kRowPieces);
-  for (RowsSelected& p : pieces) p.clear();
+// The second pass over row v of coarse level l: its points from point k on.
+void write_coarse_row(const Pyramid& pyramid, std::size_t l, float fB, const Reference& ref, int v,
+                      std::size_t k, RefLevel* level) {
+  const LevelCamera& c = pyramid.cameras[l];
+  const cv::Mat& I = pyramid.images[l];
+  const float* D = ref.level_disparity.ptr<float>(v);
+  for (int u = 1; u < c.width - 1; ++u) {
+    if (std::isnan(D[u])) continue;
+    float gx, gy;
+    gradient(I, u, v, &gx, &gy);
+    set_point(k++, static_cast<float>(u), static_cast<float>(v), gx, gy, I.ptr<float>(v)[u], D[u],
+              c, fB, level);
+  }
+}
+
+// Rows [first, last) of a level in two passes, each in pieces of rows on OpenCV's threads:
+// count(v0, v1) sets ref->row_points of its rows, then write(v, k) writes row v's points from
+// point k on (rows without points are skipped), so the points lie in row order, as a serial
+// pass would append them.
+template <class Count, class Write>
+void select_rows(int first, int last, bool with_textured, Reference* ref, RefLevel* level,
+                 const Count& count, const Write& write) {
   const std::size_t rows = static_cast<std::size_t>(std::max(last - first, 0));
-  for_each_piece(rows, kRowPieces, [&](std::size_t k, std::size_t r0, std::size_t r1) {
-    select(first + static_cast<int>(r0), first + static_cast<int>(r1), &pieces[k]);
+  for_each_piece(rows, kRowPieces, [&](std::size_t, std::size_t r0, std::size_t r1) {
+    count(first + static_cast<int>(r0), first + static_cast<int>(r1));
   });
-  level->clear();
-  for (const RowsSelected& p : pieces) level->append(p.level);
+  std::size_t total = 0;
+  for (int v = first; v < last; ++v) {
+    ref->row_offset[static_cast<std::size_t>(v)] = total;
+    total += static_cast<std::size_t>(ref->row_points[static_cast<std::size_t>(v)]);
+  }
+  level->resize(total, with_textured);
+  for_each_piece(rows, kRowPieces, [&](std::size_t, std::size_t r0, std::size_t r1) {
+    for (int v = first + static_cast<int>(r0); v < first + static_cast<int>(r1); ++v)
+      if (ref->row_points[static_cast<std::size_t>(v)] > 0)
+        write(v, ref->row_offset[static_cast<std::size_t>(v)]);
+  });
+}
+
+// The per-row scratch of ref for a level of `rows` rows.
+void size_rows(std::size_t rows, Reference* ref) {
+  ref->row_points.assign(rows, 0);
+  ref->row_offset.assign(rows, 0);
 }
 
 }  // namespace
@@ -237,14 +289,18 @@ void build_reference(const Pyramid& pyramid, const cv::Mat& disparity, double ba
   out->textured.row(H - 1).setTo(0);
   const int v_end =
       std::min(H - 1, static_cast<int>(std::ceil((1.0 - selection.lower_mask_fraction) * H)));
-  select_rows(1, H - 1, out, &out->levels.back(), [&](int v0, int v1, RowsSelected* sel) {
-    select_full_rows(pyramid, disparity, fB, selection, v_end, v0, v1, &out->textured, sel);
-  });
+  size_rows(static_cast<std::size_t>(H), out);
+  out->row_textured.assign(static_cast<std::size_t>(H), 0);
+  out->row_both.assign(static_cast<std::size_t>(H), 0);
+  select_rows(
+      1, H - 1, /*with_textured=*/true, out, &out->levels.back(),
+      [&](int v0, int v1) { count_full_rows(pyramid, disparity, selection, v_end, v0, v1, out); },
+      [&](int v, std::size_t k) {
+        write_full_row(pyramid, disparity, fB, selection, *out, v, k, &out->levels.back());
+      });
   out->textured_pixels = out->textured_depth_pixels = 0;
-  for (const RowsSelected& p : out->pieces) {
-    out->textured_pixels += p.textured;
-    out->textured_depth_pixels += p.both;
-  }
+  for (const int n : out->row_textured) out->textured_pixels += n;
+  for (const int n : out->row_both) out->textured_depth_pixels += n;
 
   for (std::size_t l = 0; l + 1 < n_levels; ++l) {
     const LevelCamera& c = pyramid.cameras[l];
@@ -253,9 +309,14 @@ void build_reference(const Pyramid& pyramid, const cv::Mat& disparity, double ba
     const int level_end =
         std::min(c.height - 1,
                  static_cast<int>(std::ceil((1.0 - selection.lower_mask_fraction) * c.height)));
-    select_rows(1, level_end, out, &out->levels[l], [&](int v0, int v1, RowsSelected* sel) {
-      select_coarse_rows(pyramid, l, disparity, fB, selection, *out, v0, v1, sel);
-    });
+    size_rows(static_cast<std::size_t>(c.height), out);
+    out->level_disparity.create(c.height, c.width, CV_32FC1);
+    select_rows(
+        1, level_end, /*with_textured=*/false, out, &out->levels[l],
+        [&](int v0, int v1) { count_coarse_rows(pyramid, l, disparity, selection, v0, v1, out); },
+        [&](int v, std::size_t k) {
+          write_coarse_row(pyramid, l, fB, *out, v, k, &out->levels[l]);
+        });
   }
 }
 

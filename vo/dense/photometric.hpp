@@ -95,21 +95,11 @@ struct RefLevel {
     textured.clear();
   }
   std::size_t size() const { return points.size(); }
-  void append(const RefLevel& more) {
-    points.insert(points.end(), more.points.begin(), more.points.end());
-    jacobians.insert(jacobians.end(), more.jacobians.begin(), more.jacobians.end());
-    textured.insert(textured.end(), more.textured.begin(), more.textured.end());
-  }
-};
-
-/// What a piece of rows of a level selects (build_reference's scratch): its points and, at full
-/// resolution, its textured pixels and those of them with depth.
-struct RowsSelected {
-  RefLevel level;
-  int textured = 0, both = 0;
-  void clear() {
-    level.clear();
-    textured = both = 0;
+  /// n points (and n textured flags, or none); what was there is overwritten.
+  void resize(std::size_t n, bool with_textured) {
+    points.resize(n);
+    jacobians.resize(n);
+    textured.resize(with_textured ? n : 0);
   }
 };
 
@@ -129,7 +119,11 @@ struct Reference {
   int textured_depth_pixels = 0;  ///< of those, with a valid depth
   cv::Mat textured;               ///< scratch: full-resolution texture mask, CV_8UC1 0/1
   std::vector<int> col_first, col_last, row_first, row_last;  ///< scratch: coarse pixel blocks
-  std::vector<RowsSelected> pieces;                           ///< scratch: pieces of rows
+  /// scratch, per row of the level being selected: its points and the index of its first one
+  std::vector<int> row_points;
+  std::vector<std::size_t> row_offset;
+  std::vector<int> row_textured, row_both;  ///< scratch, per full-resolution row
+  cv::Mat level_disparity;  ///< scratch: a coarse level's disparities, NaN where not kept
 };
 
 /// Builds the reference of a frame from its pyramid and its full-resolution disparity
