@@ -12,6 +12,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -24,6 +25,7 @@
 #include "tests/support/test_support.hpp"
 #include "tests/vo/determinism.hpp"
 #include "tests/vo/vo_test_sequences.hpp"
+#include "vo/dense/box_filter.hpp"
 #include "vo/dense/disparity.hpp"
 #include "vo/dense/photometric.hpp"
 
@@ -379,6 +381,59 @@ TEST(DenseDisparityTest, RefinementDropsMatchesTheRightImageDoesNotConfirm) {
               checked);
   EXPECT_GT(unchecked, 10000);
   EXPECT_LT(checked, 100);
+}
+
+TEST(DenseBoxFilterTest, RowsAreTheWindowSumsAndOpenCvsBytes) {
+  // box_filter_rows on pieces of rows of an image of products of gradients and residuals (what
+  // the refinement sums): within 1e-6 of each window's sum in long double and, on the OpenCV the
+  // project is built against (Debian's 4.6), the bytes of cv::boxFilter on the same rows.
+  const Sequence& seq = dense_straight_640();
+  cv::Mat left, right, dx;
+  seq.frames[1].left.convertTo(left, CV_32F);
+  seq.frames[1].right.convertTo(right, CV_32F);
+  cv::Sobel(right, dx, CV_32F, 1, 0, 1, 0.5);
+  const cv::Mat products = dx.mul(left - right);
+  // And one whose double sums round (the products above are multiples of 0.5 below 2^17, whose
+  // sums are exact): the products scaled by 1e-6 with a spike of 2^40 / 3 on every 97th pixel, so
+  // a change in the order of the additions changes bytes.
+  cv::Mat spiky = products * 1e-6;
+  for (std::size_t i = 0; i < spiky.total(); i += 97)
+    spiky.ptr<float>()[i] = ((i / 97) % 2 != 0 ? 1.0f : -1.0f) * 0x1p40f / 3.0f;
+  for (const cv::Mat& src : {products, spiky}) {
+    const int H = src.rows, W = src.cols;
+    for (const int window : {3, 5, 9, 11}) {
+      for (const bool normalize : {false, true}) {
+        cv::Mat ours(src.size(), CV_32FC1, cv::Scalar(0)), cv_rows(src.size(), CV_32FC1);
+        for (const auto& [v0, v1] :
+             std::vector<std::pair<int, int>>{{0, 37}, {37, 300}, {300, H}}) {
+          dense::box_filter_rows(src, v0, v1, window, normalize, &ours);
+          const cv::Rect rows(0, v0, W, v1 - v0);
+          cv::Mat out = cv_rows(rows);
+          cv::boxFilter(src(rows), out, CV_32F, cv::Size(window, window), cv::Point(-1, -1),
+                        normalize, cv::BORDER_CONSTANT);
+        }
+        const int r = window / 2;
+        double worst = 0.0;
+        for (int v = 0; v < H; v += 7)
+          for (int u = 0; u < W; u += 3) {
+            long double sum = 0.0L;
+            for (int y = std::max(0, v - r); y <= std::min(H - 1, v + r); ++y)
+              for (int x = std::max(0, u - r); x <= std::min(W - 1, u + r); ++x)
+                sum += src.at<float>(y, x);
+            if (normalize) sum /= window * window;
+            worst = std::max(worst, static_cast<double>(std::abs(sum - ours.at<float>(v, u)) /
+                                                        (1.0L + std::abs(sum))));
+          }
+        if (src.data == products.data) {
+          EXPECT_LT(worst, 1e-6) << "window " << window << (normalize ? ", means" : ", sums");
+        }
+#if CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR == 6
+        EXPECT_EQ(cv::norm(ours, cv_rows, cv::NORM_INF), 0.0)
+            << "window " << window << (normalize ? ", means" : ", sums");
+#endif
+      }
+    }
+  }
 }
 
 TEST(DenseDisparityTest, RefinementInLanesGivesTheBytesOfThePlainLoop) {

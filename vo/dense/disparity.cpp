@@ -8,19 +8,22 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.hpp"
+#include "vo/dense/box_filter.hpp"
 #include "vo/dense/pieces.hpp"
 
 namespace driftlab::vo::dense {
 
 namespace {
 
-// cv::boxFilter with zeros beyond the image, in pieces of rows. Its running column sums start
-// afresh in each piece; the pieces are the same at any thread count.
+// cv::boxFilter's sums with zeros beyond the image (box_filter_rows), in pieces of rows. The
+// running column sums start afresh in each piece; the pieces are the same at any thread count.
 void box_filter(const cv::Mat& src, cv::Mat* dst, int window, bool normalize) {
-  filter_in_row_pieces(src, dst, CV_32FC1, [&](const cv::Mat& in, cv::Mat& out) {
-    cv::boxFilter(in, out, CV_32F, cv::Size(window, window), cv::Point(-1, -1), normalize,
-                  cv::BORDER_CONSTANT);
-  });
+  dst->create(src.size(), CV_32FC1);
+  for_each_piece(static_cast<std::size_t>(src.rows), kRowPieces,
+                 [&](std::size_t, std::size_t v0, std::size_t v1) {
+                   box_filter_rows(src, static_cast<int>(v0), static_cast<int>(v1), window,
+                                   normalize, dst);
+                 });
 }
 
 }  // namespace
