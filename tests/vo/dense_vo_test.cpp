@@ -233,6 +233,45 @@ TEST(DenseJacobianTest, ReferenceJacobiansMatchFiniteDifferencesOnEveryLevel) {
   }
 }
 
+TEST(DenseWarpTest, ResidualsInLanesGiveTheBytesOfThePlainLoop) {
+  // The alignment's warp runs four points at a time with a plain loop for the rest: on the
+  // reference of a real frame, at every level, for a small motion and for one that takes points
+  // out of the image, both give the same residuals bit for bit, NaN included, and the same count.
+  const Sequence& seq = dense_straight_640();
+  const DenseVoOptions o;
+  dense::Pyramid pyr;
+  pyr.configure(seq.rig.camera, o.pyramid_scales);
+  pyr.build(seq.frames[1].left, o.pyramid_blur_sigma_px);
+  cv::Mat left_f, disparity;
+  seq.frames[1].left.convertTo(left_f, CV_32F);
+  dense::DisparityEstimator(dense::disparity_options(o))
+      .compute(seq.frames[1].left, seq.frames[1].right, left_f, &disparity);
+  dense::Reference ref;
+  dense::build_reference(pyr, disparity, seq.rig.camera.fx * seq.rig.baseline_m,
+                         dense::RefSelection{}, &ref);
+  Vec6 small, large;
+  small << 0.02, -0.01, 0.05, 0.002, -0.003, 0.001;
+  large << 1.5, 0.8, 0.3, 0.0, 0.2, 0.05;
+  for (const Vec6& xi : {small, large}) {
+    for (std::size_t l = 0; l < pyr.cameras.size(); ++l) {
+      const std::vector<dense::RefPoint>& pts = ref.levels[l].points;
+      const std::size_t n = (pts.size() - 3) / 4 * 4 + 3;  // three points past the lanes
+      ASSERT_LE(n, pts.size());
+      std::vector<float> lanes(n), plain(n);
+      const int used = dense::warp_residuals(pts.data(), n, pyr.images[l], pyr.cameras[l],
+                                             SE3::exp(xi), true, lanes.data());
+      EXPECT_EQ(dense::warp_residuals(pts.data(), n, pyr.images[l], pyr.cameras[l], SE3::exp(xi),
+                                      false, plain.data()),
+                used);
+      EXPECT_EQ(std::memcmp(lanes.data(), plain.data(), n * sizeof(float)), 0) << "level " << l;
+      EXPECT_GT(used, 0);
+      if (xi == large) {
+        EXPECT_LT(used, static_cast<int>(n)) << "level " << l;
+      }
+    }
+  }
+}
+
 TEST(DensePyramidTest, LevelCamerasFollowCvResize) {
   // A linear ramp survives bilinear resizing exactly, so each level pixel's value is the
   // full-image coordinate of its centre; the level camera must agree.

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <Eigen/Cholesky>
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.hpp"
@@ -326,18 +327,116 @@ double Aligner::cost_scale() const {
   return options_.robust ? options_.t_dof / (options_.t_dof + 1.0) : 1.0;
 }
 
+namespace {
+
+// What warp() needs of the motion and the level: R, t, the intrinsics and the image.
+struct WarpModel {
+  float R[3][3], t[3];
+  float fx, fy, cx, cy, umax, vmax;
+  const float* base;
+  std::size_t stride;
+
+  // Eq. (6), G = R P + T, then Eq. (7), and Eq. (9)'s residual: the current image at the warped
+  // pixel (Eq. (8)), bilinear, minus the reference; NaN where the point leaves the image or
+  // falls behind the camera.
+  float residual(const RefPoint& p) const {
+    const float qx = R[0][0] * p.x + R[0][1] * p.y + R[0][2] * p.z + t[0];
+    const float qy = R[1][0] * p.x + R[1][1] * p.y + R[1][2] * p.z + t[1];
+    const float qz = R[2][0] * p.x + R[2][1] * p.y + R[2][2] * p.z + t[2];
+    const float iz = 1.0f / qz;
+    const float u = fx * qx * iz + cx, v = fy * qy * iz + cy;
+    if (!(qz > 1e-3f) || !(u >= 0.0f && u < umax && v >= 0.0f && v < vmax))
+      return std::numeric_limits<float>::quiet_NaN();
+    const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
+    const float ax = u - static_cast<float>(x0), ay = v - static_cast<float>(y0);
+    const float* q0 = base + static_cast<std::size_t>(y0) * stride + x0;
+    const float* q1 = q0 + stride;
+    const float top = q0[0] + ax * (q0[1] - q0[0]);
+    const float bottom = q1[0] + ax * (q1[1] - q1[0]);
+    return top + ay * (bottom - top) - p.intensity;
+  }
+
+#if CV_SIMD128
+  // residual() of the four points from p, lane by lane in the same operations (OpenCV's
+  // universal intrinsics): the same bytes. Returns how many are finite.
+  int residuals4(const RefPoint* p, float* out) const {
+    using V = cv::v_float32x4;
+    V X = cv::v_load(&p[0].x), Y = cv::v_load(&p[1].x), Z = cv::v_load(&p[2].x),
+      I = cv::v_load(&p[3].x);
+    cv::v_transpose4x4(V(X), V(Y), V(Z), V(I), X, Y, Z, I);
+    auto row = [&](int k) {
+      return cv::v_setall_f32(R[k][0]) * X + cv::v_setall_f32(R[k][1]) * Y +
+             cv::v_setall_f32(R[k][2]) * Z + cv::v_setall_f32(t[k]);
+    };
+    const V qx = row(0), qy = row(1), qz = row(2);
+    const V iz = cv::v_setall_f32(1.0f) / qz, zero = cv::v_setzero_f32();
+    const V u = cv::v_setall_f32(fx) * qx * iz + cv::v_setall_f32(cx);
+    const V v = cv::v_setall_f32(fy) * qy * iz + cv::v_setall_f32(cy);
+    const V ok = (qz > cv::v_setall_f32(1e-3f)) & (u >= zero) & (u < cv::v_setall_f32(umax)) &
+                 (v >= zero) & (v < cv::v_setall_f32(vmax));
+    const V us = cv::v_select(ok, u, zero), vs = cv::v_select(ok, v, zero);
+    const cv::v_int32x4 x0 = cv::v_trunc(us), y0 = cv::v_trunc(vs);
+    const V ax = us - cv::v_cvt_f32(x0), ay = vs - cv::v_cvt_f32(y0);
+    const cv::v_int32x4 at = y0 * cv::v_setall_s32(static_cast<int>(stride)) + x0;
+    const V a00 = cv::v_lut(base, at), a01 = cv::v_lut(base + 1, at);
+    const V a10 = cv::v_lut(base + stride, at), a11 = cv::v_lut(base + stride + 1, at);
+    const V top = a00 + ax * (a01 - a00), bottom = a10 + ax * (a11 - a10);
+    const V r = top + ay * (bottom - top) - I;
+    cv::v_store(out,
+                cv::v_select(ok, r, cv::v_setall_f32(std::numeric_limits<float>::quiet_NaN())));
+    return __builtin_popcount(static_cast<unsigned>(cv::v_signmask(ok)));
+  }
+#endif
+};
+
+WarpModel warp_model(const cv::Mat& image, const LevelCamera& cam, const SE3& T) {
+  WarpModel m;
+  const Eigen::Matrix3f R = T.rotation().cast<float>();
+  const Eigen::Vector3f t = T.translation().cast<float>();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) m.R[r][c] = R(r, c);
+    m.t[r] = t(r);
+  }
+  m.fx = static_cast<float>(cam.fx);
+  m.fy = static_cast<float>(cam.fy);
+  m.cx = static_cast<float>(cam.cx);
+  m.cy = static_cast<float>(cam.cy);
+  m.umax = static_cast<float>(image.cols - 1);
+  m.vmax = static_cast<float>(image.rows - 1);
+  m.base = image.ptr<float>(0);
+  m.stride = image.step1();
+  return m;
+}
+
+int residuals_of(const WarpModel& m, const RefPoint* points, std::size_t n, bool lanes,
+                 float* out) {
+  int used = 0;
+  std::size_t i = 0;
+#if CV_SIMD128
+  for (; lanes && i + 4 <= n; i += 4) used += m.residuals4(points + i, out + i);
+#else
+  static_cast<void>(lanes);
+#endif
+  for (; i < n; ++i) {
+    out[i] = m.residual(points[i]);
+    used += out[i] == out[i] ? 1 : 0;
+  }
+  return used;
+}
+
+}  // namespace
+
+int warp_residuals(const RefPoint* points, std::size_t n, const cv::Mat& image,
+                   const LevelCamera& cam, const SE3& T, bool lanes, float* out) {
+  DRIFTLAB_DEMAND(image.type() == CV_32FC1);
+  return residuals_of(warp_model(image, cam, T), points, n, lanes, out);
+}
+
 int Aligner::warp(const RefLevel& level, const cv::Mat& image, const LevelCamera& cam, const SE3& T,
                   double sigma2, std::vector<float>* residuals, double* cost) const {
   const std::vector<RefPoint>& points = level.points;
   residuals->resize(points.size());
-  const Eigen::Matrix3f R = T.rotation().cast<float>();
-  const Eigen::Vector3f t = T.translation().cast<float>();
-  const float fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy);
-  const float cx = static_cast<float>(cam.cx), cy = static_cast<float>(cam.cy);
-  const float umax = static_cast<float>(image.cols - 1), vmax = static_cast<float>(image.rows - 1);
-  const float* base = image.ptr<float>(0);
-  const std::size_t stride = image.step1();
-  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  const WarpModel m = warp_model(image, cam, T);
   float* out = residuals->data();
   // The step-acceptance cost: r^2 (least squares) or a bounded surrogate of the
   // t-distribution's negative log-likelihood with the same quadratic core (its log would cost
@@ -349,34 +448,12 @@ int Aligner::warp(const RefLevel& level, const cv::Mat& image, const LevelCamera
   std::vector<float> block_cost(n_blocks);
   std::vector<int> block_used(n_blocks);
   for_each_block(points.size(), kBlock, [&](std::size_t b, std::size_t begin, std::size_t end) {
-    int used = 0;
-    for (std::size_t i = begin; i < end; ++i) {
-      const RefPoint& p = points[i];
-      // Eq. (6), G = R P + T, then Eq. (7).
-      const float qx = R(0, 0) * p.x + R(0, 1) * p.y + R(0, 2) * p.z + t.x();
-      const float qy = R(1, 0) * p.x + R(1, 1) * p.y + R(1, 2) * p.z + t.y();
-      const float qz = R(2, 0) * p.x + R(2, 1) * p.y + R(2, 2) * p.z + t.z();
-      const float iz = 1.0f / qz;
-      const float u = fx * qx * iz + cx, v = fy * qy * iz + cy;
-      if (!(qz > 1e-3f) || !(u >= 0.0f && u < umax && v >= 0.0f && v < vmax)) {
-        out[i] = kNaN;
-        continue;
-      }
-      // Eq. (9)'s residual: the current image at the warped pixel (Eq. (8)), bilinear, minus
-      // the reference.
-      const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
-      const float ax = u - static_cast<float>(x0), ay = v - static_cast<float>(y0);
-      const float* q0 = base + static_cast<std::size_t>(y0) * stride + x0;
-      const float* q1 = q0 + stride;
-      const float top = q0[0] + ax * (q0[1] - q0[0]);
-      const float bottom = q1[0] + ax * (q1[1] - q1[0]);
-      out[i] = top + ay * (bottom - top) - p.intensity;
-      ++used;
-    }
+    const int used =
+        residuals_of(m, points.data() + begin, end - begin, /*lanes=*/true, out + begin);
     // A separate branch-free pass over the block, so that it vectorises.
     float sum = 0.0f;
-    for (std::size_t i = begin; i < end; ++i) {
-      const float r = out[i];
+    for (std::size_t k = begin; k < end; ++k) {
+      const float r = out[k];
       const float rho = r * r / (1.0f + r * r * inv_nu_s2);
       sum += r == r ? rho : 0.0f;  // NaN: not compared
     }

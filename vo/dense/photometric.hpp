@@ -136,6 +136,14 @@ struct Reference {
 void build_reference(const Pyramid& pyramid, const cv::Mat& disparity, double baseline_fx,
                      const RefSelection& selection, Reference* out);
 
+/// Eq. (9)'s residual I(warp(P)) - I_ref of each of the n points at motion T into out[0..n):
+/// the current level image (CV_32FC1, camera `cam`) at the pixel where Eqs. (6)-(7) put the
+/// point, bilinear, minus its intensity; NaN where it leaves the image or falls behind the
+/// camera. Returns the number of finite residuals. `lanes`: four points at a time where the build
+/// has SIMD (OpenCV's universal intrinsics), else one at a time; the same bytes (tests compare).
+int warp_residuals(const RefPoint* points, std::size_t n, const cv::Mat& image,
+                   const LevelCamera& cam, const SE3& T, bool lanes, float* out);
+
 struct AlignOptions {
   std::vector<int> max_iterations;  ///< per level, coarsest first
   double initial_lambda = 1e-4;
