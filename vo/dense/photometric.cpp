@@ -1,6 +1,7 @@
 #include "vo/dense/photometric.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -384,7 +385,7 @@ struct WarpModel {
     const V r = top + ay * (bottom - top) - I;
     cv::v_store(out,
                 cv::v_select(ok, r, cv::v_setall_f32(std::numeric_limits<float>::quiet_NaN())));
-    return __builtin_popcount(static_cast<unsigned>(cv::v_signmask(ok)));
+    return std::popcount(static_cast<unsigned>(cv::v_signmask(ok)));
   }
 #endif
 };
