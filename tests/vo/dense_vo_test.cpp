@@ -54,6 +54,14 @@ const Sequence& dense_turn_640() {
                                           test::turning_poses(5, 0.5, 2.0));
   return s;
 }
+// The dense VO's pyramid (its default scales and blur) of the left image of frame `frame`.
+dense::Pyramid default_pyramid(const Sequence& seq, std::size_t frame) {
+  const DenseVoOptions o;
+  dense::Pyramid pyr;
+  pyr.configure(seq.rig.camera, o.pyramid_scales);
+  pyr.build(seq.frames[frame].left, o.pyramid_blur_sigma_px);
+  return pyr;
+}
 const Sequence& dense_straight_kitti() {
   static const Sequence s = make_sequence(test::river_bank_scene_kitti(), test::kitti_rig(),
                                           test::straight_poses(4, 0.5));
@@ -239,9 +247,7 @@ TEST(DenseWarpTest, ResidualsInLanesGiveTheBytesOfThePlainLoop) {
   // out of the image, both give the same residuals bit for bit, NaN included, and the same count.
   const Sequence& seq = dense_straight_640();
   const DenseVoOptions o;
-  dense::Pyramid pyr;
-  pyr.configure(seq.rig.camera, o.pyramid_scales);
-  pyr.build(seq.frames[1].left, o.pyramid_blur_sigma_px);
+  const dense::Pyramid pyr = default_pyramid(seq, 1);
   cv::Mat left_f, disparity;
   seq.frames[1].left.convertTo(left_f, CV_32F);
   dense::DisparityEstimator(dense::disparity_options(o))
@@ -303,9 +309,7 @@ TEST(DensePyramidTest, BlurInPiecesOfRowsEqualsOneBlurOfTheWholeImage) {
   // rows around it, so the levels are those of one cv::GaussianBlur and one cv::resize.
   const Sequence& seq = dense_turn_640();
   const DenseVoOptions o;
-  dense::Pyramid pyr;
-  pyr.configure(seq.rig.camera, o.pyramid_scales);
-  pyr.build(seq.frames[1].left, o.pyramid_blur_sigma_px);
+  const dense::Pyramid pyr = default_pyramid(seq, 1);
   cv::Mat full, blurred;
   seq.frames[1].left.convertTo(full, CV_32F);
   const int k = 2 * static_cast<int>(std::ceil(3.0 * o.pyramid_blur_sigma_px)) + 1;
