@@ -194,6 +194,7 @@ struct StereoRenderer::Impl {
   GLuint depth_fbo = 0, depth_tex = 0, depth_rb = 0;
   Eigen::Matrix4f proj;
   std::vector<std::pair<float, std::size_t>> draw_order;  // scratch for draw_scene
+  WaterOrder water_order = WaterOrder::kByCost;            // draw_eye_rows
 
   void build_water_grid();
   void build_framebuffers();
@@ -931,13 +932,27 @@ void StereoRenderer::Impl::draw_eye_rows(const SE3& T_W_C, double t, int eye_ind
     glEnable(GL_SCISSOR_TEST);
     glScissor(0, row_begin, W, row_end - row_begin);
   }
-  // The water first (near and large, it hides much of the banks below it),
-  // then the scene nearest first, then the sky on the far plane where nothing
-  // was drawn: every pixel is shaded about once.
-  draw_water(view, eye, t, 0, reflects() ? e.refl_tex : 0);
-  lap(&RenderPassTimes::water_ms);
+  // The water and the scene nearest first, then the sky on the far plane where nothing was
+  // drawn. Calm, the water goes first (near and large, it hides much of the banks below it);
+  // with ripples its shader is the costliest (the mirror's taps), so it goes after the scene
+  // and llvmpipe's early depth test skips it behind the banks. Where the water meets a surface
+  // at the same depth the pixel shows the water either way (GL_LEQUAL when it comes second):
+  // the same bytes in both orders.
+  const GLuint reflection = reflects() ? e.refl_tex : 0;
+  const bool water_last = water_order == WaterOrder::kByCost ? ripples != nullptr
+                                                             : water_order == WaterOrder::kLast;
+  if (!water_last) {
+    draw_water(view, eye, t, 0, reflection);
+    lap(&RenderPassTimes::water_ms);
+  }
   draw_scene(view, eye, 1.f, 0, t);
   lap(&RenderPassTimes::scene_ms);
+  if (water_last) {
+    glDepthFunc(GL_LEQUAL);
+    draw_water(view, eye, t, 0, reflection);
+    glDepthFunc(GL_LESS);
+    lap(&RenderPassTimes::water_ms);
+  }
   draw_sky(view, 1.f);
   lap(&RenderPassTimes::sky_ms);
   if (band) glDisable(GL_SCISSOR_TEST);
@@ -1002,8 +1017,8 @@ TruthImages StereoRenderer::Impl::render_truth(const SE3& T_W_C, double t) {
   glClearColor(0, 0, 0, 0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
-  // In the eye pass's order (draw_eye_rows): where the water and a surface meet at the same
-  // depth, the pixel shows the water, in the image and here.
+  // As in the eye pass (draw_eye_rows, in either order): where the water and a surface meet at
+  // the same depth, the pixel shows the water, in the image and here.
   draw_water(view, eye, t, 1, 0);
   draw_scene(view, eye, 1.f, 1, t);
   glFinish();
@@ -1086,6 +1101,8 @@ bool StereoRenderer::has_moving_things() const {
          (!m.sway.empty() && std::any_of(m.meshes.begin(), m.meshes.end(),
                                          [](const GpuMesh& g) { return g.sway_vbo != 0; }));
 }
+
+void StereoRenderer::set_water_order(WaterOrder order) { impl_->water_order = order; }
 
 void StereoRenderer::set_body_pose(const SE3& T_W_B) {
   impl_->T_W_B = T_W_B.matrix().cast<float>();

@@ -154,6 +154,13 @@ class StereoRenderer {
   ColourImage render_colour(const SE3& T_W_C, double t_s);
   const std::string& context_description() const;
   std::size_t triangles() const;
+  /// Where the eye pass draws the water beside the scene: it changes the cost, never the bytes
+  /// (a pixel where the water meets a surface at the same depth shows the water in both
+  /// orders). By cost, the default: after the scene when ripples make its shader the costliest
+  /// (llvmpipe then skips it behind the banks), before it when calm (it hides the banks below
+  /// it). The other two for tests that compare the orders.
+  enum class WaterOrder { kByCost, kFirst, kLast };
+  void set_water_order(WaterOrder order);
   /// Times each pass from now on (glFinish after each: slower, the same images) into
   /// pass_times(), reset here; false stops.
   void set_profiling(bool on);

@@ -496,6 +496,59 @@ TEST(Render, ProfilingTimesEachPassDrawnAndLeavesTheImagesAsTheyAre) {
 // mirror images that their rows read (StereoRenderer::Impl::reflection_rows), so steep waves,
 // which move the reflection lookup by up to 0.15 x 0.6 of the image (about 43 rows), and a
 // camera that moves and turns from band to band would show any row read from an earlier band.
+TEST(Render, TheWaterBeforeOrAfterTheSceneGivesTheSameBytes) {
+  // A bank sloping out of the water beside a disc: its near part under the water (the water
+  // hides it), its far part above (it hides the water behind it). Calm, with a wave, with
+  // ripples; single-sampled and 4x multisampled: the water drawn first or last, the same bytes.
+  SceneGeometry scene = checker_disc_over_water(Vec3(8, 0, -1.2), 1.0, 40, 220);
+  scene.meshes.push_back(quad_mesh(
+      {Vec3(5, -2.5, 0.4), Vec3(5, -0.5, 0.4), Vec3(12, -0.5, -1.0), Vec3(12, -2.5, -1.0)},
+      Vec3(-0.2, 0, -1).normalized(), true));
+  const SE3 T_W_C = camera_at(Vec3(0, 0, -0.5));
+  WindOptions wind;
+  wind.speed_mps = 3.0;
+  const WaveComponent wave{0.02, 2 * std::numbers::pi / 1.5, 3.0, 0.3, 0.1};
+  using Order = StereoRenderer::WaterOrder;
+  for (const int samples : {1, 4}) {
+    RenderOptions o;
+    o.msaa_samples = samples;
+    StereoRenderer r(rig_640(), o);
+    r.upload(scene);
+    for (const int water : {0, 1, 2}) {  // calm, a wave, ripples
+      r.set_waves(water == 1 ? std::vector<WaveComponent>{wave} : std::vector<WaveComponent>{});
+      r.set_ripples(water == 2 ? std::make_shared<RippleMaps>(wind, CurrentOptions{},
+                                                              RngStreams(3).stream("water.ripples"))
+                               : nullptr);
+      std::vector<StereoImages> got;
+      for (const Order order : {Order::kFirst, Order::kLast, Order::kByCost}) {
+        r.set_water_order(order);
+        got.push_back(r.render(T_W_C, 1.25, false));
+      }
+      for (std::size_t k : {1u, 2u}) {
+        EXPECT_TRUE(got[0].left.pixels == got[k].left.pixels) << samples << " " << water << " " << k;
+        EXPECT_TRUE(got[0].right.pixels == got[k].right.pixels) << samples << " " << water;
+      }
+    }
+  }
+  // Both kinds of hiding happen (columns left of the disc, rows below the horizon): the depth
+  // with the water against the bank's own depth (the water switched off).
+  StereoRenderer r(rig_640(), RenderOptions{});
+  r.upload(scene);
+  const DepthImage wet = r.render_truth(T_W_C, 1.25).depth;
+  scene.water.enabled = false;
+  r.upload(scene);
+  const DepthImage dry = r.render_truth(T_W_C, 1.25).depth;
+  int water_hides_bank = 0, bank_hides_water = 0;
+  for (int y = 241; y < 480; ++y)
+    for (int x = 0; x < 250; ++x) {
+      if (dry.at(x, y) <= 0.f) continue;
+      water_hides_bank += wet.at(x, y) < dry.at(x, y) - 1e-3f;
+      bank_hides_water += wet.at(x, y) == dry.at(x, y);
+    }
+  EXPECT_GT(water_hides_bank, 2000);
+  EXPECT_GT(bank_hides_water, 2000);
+}
+
 TEST(Render, BandsEqualWholeFramesAtEachBandsPose) {
   SceneGeometry scene = checker_disc_over_water(Vec3(8, 0, -1.2), 1.0, 40, 220);
   // And a copy of the disc moving east behind it at 3 m/s (4 px from band to band), so that
