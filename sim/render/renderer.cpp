@@ -194,7 +194,7 @@ struct StereoRenderer::Impl {
   GLuint depth_fbo = 0, depth_tex = 0, depth_rb = 0;
   Eigen::Matrix4f proj;
   std::vector<std::pair<float, std::size_t>> draw_order;  // scratch for draw_scene
-  WaterOrder water_order = WaterOrder::kByCost;            // draw_eye_rows
+  WaterOrder water_order = WaterOrder::kByCost;           // draw_eye_rows
 
   void build_water_grid();
   void build_framebuffers();
@@ -939,8 +939,8 @@ void StereoRenderer::Impl::draw_eye_rows(const SE3& T_W_C, double t, int eye_ind
   // at the same depth the pixel shows the water either way (GL_LEQUAL when it comes second):
   // the same bytes in both orders.
   const GLuint reflection = reflects() ? e.refl_tex : 0;
-  const bool water_last = water_order == WaterOrder::kByCost ? ripples != nullptr
-                                                             : water_order == WaterOrder::kLast;
+  const bool water_last =
+      water_order == WaterOrder::kByCost ? ripples != nullptr : water_order == WaterOrder::kLast;
   if (!water_last) {
     draw_water(view, eye, t, 0, reflection);
     lap(&RenderPassTimes::water_ms);

@@ -525,7 +525,8 @@ TEST(Render, TheWaterBeforeOrAfterTheSceneGivesTheSameBytes) {
         got.push_back(r.render(T_W_C, 1.25, false));
       }
       for (std::size_t k : {1u, 2u}) {
-        EXPECT_TRUE(got[0].left.pixels == got[k].left.pixels) << samples << " " << water << " " << k;
+        EXPECT_TRUE(got[0].left.pixels == got[k].left.pixels)
+            << samples << " " << water << " " << k;
         EXPECT_TRUE(got[0].right.pixels == got[k].right.pixels) << samples << " " << water;
       }
     }
