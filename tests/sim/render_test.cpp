@@ -491,11 +491,6 @@ TEST(Render, ProfilingTimesEachPassDrawnAndLeavesTheImagesAsTheyAre) {
   }
 }
 
-// A rolling-shutter image, band by band, against its second method: each band's rows cut out of
-// a whole frame rendered at that band's pose and time. The bands draw only the rows of their
-// mirror images that their rows read (StereoRenderer::Impl::reflection_rows), so steep waves,
-// which move the reflection lookup by up to 0.15 x 0.6 of the image (about 43 rows), and a
-// camera that moves and turns from band to band would show any row read from an earlier band.
 TEST(Render, TheWaterBeforeOrAfterTheSceneGivesTheSameBytes) {
   // A bank sloping out of the water beside a disc: its near part under the water (the water
   // hides it), its far part above (it hides the water behind it). Calm, with a wave, with
@@ -550,6 +545,11 @@ TEST(Render, TheWaterBeforeOrAfterTheSceneGivesTheSameBytes) {
   EXPECT_GT(bank_hides_water, 2000);
 }
 
+// A rolling-shutter image, band by band, against its second method: each band's rows cut out of
+// a whole frame rendered at that band's pose and time. The bands draw only the rows of their
+// mirror images that their rows read (StereoRenderer::Impl::reflection_rows), so steep waves,
+// which move the reflection lookup by up to 0.15 x 0.6 of the image (about 43 rows), and a
+// camera that moves and turns from band to band would show any row read from an earlier band.
 TEST(Render, BandsEqualWholeFramesAtEachBandsPose) {
   SceneGeometry scene = checker_disc_over_water(Vec3(8, 0, -1.2), 1.0, 40, 220);
   // And a copy of the disc moving east behind it at 3 m/s (4 px from band to band), so that
