@@ -16,6 +16,7 @@
 #include <string>
 #include <tuple>
 #include <utility>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/stopwatch.hpp"
@@ -31,7 +32,6 @@ namespace render {
 // A mesh uploaded to the GPU, with its bounding sphere for culling.
 struct GpuMesh {
   GLuint vao = 0, vbo = 0, ebo = 0;
-  GLsizei count = 0;
   Material material;
   bool on_body = false;  // Mesh::on_body
   int mover = -1;        // Mesh::mover
@@ -40,6 +40,15 @@ struct GpuMesh {
   bool cutout = false;   // its texture has alpha: drawn alpha-tested, after the opaque meshes
   Eigen::Vector3f centre = Eigen::Vector3f::Zero();  // bounding sphere, mesh frame
   float radius = 0;
+  // Runs of consecutive triangles with their bounding spheres (mesh frame): those outside the
+  // view are not drawn. A batch holds many small things (stones, roots, cards) spread along
+  // its cell; the vertices of those out of view would cost this thread vertex work for nothing.
+  struct Run {
+    Eigen::Vector3f centre;
+    float radius;
+    GLsizei first, count;  // in indices
+  };
+  std::vector<Run> runs;
 };
 
 }  // namespace render
@@ -76,6 +85,25 @@ bool sphere_visible(const std::array<Eigen::Vector4f, 6>& planes, const Eigen::V
   for (const auto& q : planes)
     if (q.head<3>().dot(c) + q.w() < -r) return false;
   return true;
+}
+
+// A mesh's triangles in runs of kRunTriangles, each with a sphere holding its vertices (grown
+// by a part in 10^4 and a millimetre against rounding).
+std::vector<GpuMesh::Run> triangle_runs(const Mesh& mesh) {
+  constexpr std::size_t kRunTriangles = 32;
+  std::vector<GpuMesh::Run> runs;
+  for (std::size_t first = 0; first < mesh.indices.size(); first += 3 * kRunTriangles) {
+    const std::size_t end = std::min(mesh.indices.size(), first + 3 * kRunTriangles);
+    Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = -lo;
+    for (std::size_t k = first; k < end; ++k) {
+      const Vertex& v = mesh.vertices[mesh.indices[k]];
+      lo = lo.cwiseMin(Eigen::Vector3f(v.x, v.y, v.z));
+      hi = hi.cwiseMax(Eigen::Vector3f(v.x, v.y, v.z));
+    }
+    runs.push_back({0.5f * (lo + hi), 0.5f * (hi - lo).norm() * 1.0001f + 1e-3f,
+                    static_cast<GLsizei>(first), static_cast<GLsizei>(end - first)});
+  }
+  return runs;
 }
 
 // An alpha-tested texture on the GPU: RG8 (grey, alpha), its levels keeping level 0's coverage
@@ -211,7 +239,14 @@ struct StereoRenderer::Impl {
                   double t);
   // Where mesh g is drawn: the identity, the body's pose or its mover's (T_W_M at the pass's t).
   const Eigen::Matrix4f& model_of(const GpuMesh& g) const;
-  void draw_mesh(GLuint prog, const GpuMesh& g);  // one mesh with the program in use
+  // One mesh with the program in use: its runs of triangles that can be in the view (planes,
+  // in the pass's mirrored world).
+  void draw_mesh(GLuint prog, const GpuMesh& g, const std::array<Eigen::Vector4f, 6>& planes,
+                 float mirror);
+  bool run_culling = true;               // set_run_culling
+  std::size_t triangles_submitted = 0;   // by draw_mesh
+  std::vector<GLsizei> run_counts;       // scratch for draw_mesh
+  std::vector<const void*> run_offsets;  // scratch for draw_mesh
   void draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye, double t, int mode,
                   GLuint reflection);  // 0: none
   // The sky where nothing was drawn; mirror -1: the mirrored sky below the horizon.
@@ -477,7 +512,6 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     g.mover = mesh.mover;
     g.cutout = mesh.material.texture >= 0 &&
                !scene.textures[static_cast<std::size_t>(mesh.material.texture)].alpha.empty();
-    g.count = static_cast<GLsizei>(mesh.indices.size());
     Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = -lo;
     for (const Vertex& v : mesh.vertices) {
       lo = lo.cwiseMin(Eigen::Vector3f(v.x, v.y, v.z));
@@ -485,6 +519,7 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     }
     g.centre = 0.5f * (lo + hi);
     g.radius = 0.5f * (hi - lo).norm();
+    g.runs = triangle_runs(mesh);
     glGenVertexArrays(1, &g.vao);
     glBindVertexArray(g.vao);
     glGenBuffers(1, &g.vbo);
@@ -687,14 +722,15 @@ void StereoRenderer::Impl::draw_scene(const Eigen::Matrix4f& view, const Eigen::
         glUseProgram(prog);
       ready[static_cast<std::size_t>(sways)] = true;
       bound = prog;
-      draw_mesh(prog, g);
+      draw_mesh(prog, g, planes, mirror);
     }
   }
   glBindVertexArray(0);
   glDisable(GL_CULL_FACE);
 }
 
-void StereoRenderer::Impl::draw_mesh(GLuint prog, const GpuMesh& g) {
+void StereoRenderer::Impl::draw_mesh(GLuint prog, const GpuMesh& g,
+                                     const std::array<Eigen::Vector4f, 6>& planes, float mirror) {
   if (g.material.double_sided)
     glDisable(GL_CULL_FACE);
   else
@@ -708,7 +744,30 @@ void StereoRenderer::Impl::draw_mesh(GLuint prog, const GpuMesh& g) {
   set_mat4(prog, "u_model", model_of(g));
   glUniform1f(loc(prog, "u_moving"), g.mover >= 0 ? 1.f : 0.f);  // the moving mask
   glBindVertexArray(g.vao);
-  glDrawElements(GL_TRIANGLES, g.count, GL_UNSIGNED_INT, nullptr);
+  // The runs that can be in the view, consecutive ones joined: a triangle outside the view
+  // draws no pixel, and those drawn keep their order, so the image is the same.
+  run_counts.clear();
+  run_offsets.clear();
+  const Eigen::Matrix4f& T = model_of(g);  // rigid: radii unchanged
+  const float margin = g.sway_most * sway_reach_m;
+  GLsizei end = -1;
+  for (const GpuMesh::Run& r : g.runs) {
+    const Eigen::Vector3f w = (T * r.centre.homogeneous()).head<3>();
+    if (run_culling &&
+        !sphere_visible(planes, Eigen::Vector3f(w.x(), w.y(), w.z() * mirror), r.radius + margin))
+      continue;
+    if (r.first == end) {
+      run_counts.back() += r.count;
+    } else {
+      run_counts.push_back(r.count);
+      run_offsets.push_back(reinterpret_cast<const void*>(sizeof(GLuint) * r.first));
+    }
+    end = r.first + r.count;
+    triangles_submitted += static_cast<std::size_t>(r.count / 3);
+  }
+  if (!run_counts.empty())
+    glMultiDrawElements(GL_TRIANGLES, run_counts.data(), GL_UNSIGNED_INT, run_offsets.data(),
+                        static_cast<GLsizei>(run_counts.size()));
 }
 
 void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::Vector3f& eye,
@@ -1103,6 +1162,10 @@ bool StereoRenderer::has_moving_things() const {
 }
 
 void StereoRenderer::set_water_order(WaterOrder order) { impl_->water_order = order; }
+
+void StereoRenderer::set_run_culling(bool on) { impl_->run_culling = on; }
+
+std::size_t StereoRenderer::triangles_submitted() const { return impl_->triangles_submitted; }
 
 void StereoRenderer::set_body_pose(const SE3& T_W_B) {
   impl_->T_W_B = T_W_B.matrix().cast<float>();

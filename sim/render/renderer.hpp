@@ -161,6 +161,12 @@ class StereoRenderer {
   /// it). The other two for tests that compare the orders.
   enum class WaterOrder { kByCost, kFirst, kLast };
   void set_water_order(WaterOrder order);
+  /// Whether each mesh's runs of triangles that cannot be in a pass's view are skipped (true,
+  /// the default): it changes the cost, never the bytes (a triangle outside the view draws no
+  /// pixel, and those drawn keep their order). False for tests that compare.
+  void set_run_culling(bool on);
+  /// The triangles sent to OpenGL since the renderer was made, all passes together.
+  std::size_t triangles_submitted() const;
   /// Times each pass from now on (glFinish after each: slower, the same images) into
   /// pass_times(), reset here; false stops.
   void set_profiling(bool on);

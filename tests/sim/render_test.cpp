@@ -545,6 +545,63 @@ TEST(Render, TheWaterBeforeOrAfterTheSceneGivesTheSameBytes) {
   EXPECT_GT(bank_hides_water, 2000);
 }
 
+// Runs of triangles outside a pass's view are skipped (StereoRenderer::set_run_culling): two
+// rows of 400 posts along y from -24 to 24 m, one rigid, one with its tops swaying in a gale,
+// mirrored in the water, seen by cameras turned so that the edges of the view cut the runs at
+// many places (the fine sweep of yaws brings the right edge past a run of swaying posts whose
+// tops the gust at t = 0.4 s leans into the view: without the sway's margin it would be
+// culled); drawn with the runs culled and without: the same images and truth, and most of the
+// rows' triangles never sent.
+TEST(Render, CullingRunsOfTrianglesGivesTheSameBytes) {
+  SceneGeometry scene = checker_disc_over_water(Vec3(8, 0, -1.2), 1.0, 40, 220);
+  for (const bool sways : {false, true})  // rigid posts 6 m north, swaying ones 9 m, above them
+    for (int i = 0; i < 400; ++i) {
+      const double x = sways ? 9 : 6, y = -24 + 0.12 * i, z = sways ? -1.0 : -0.1;
+      Mesh post = quad_mesh(
+          {Vec3(x, y, z), Vec3(x, y + 0.08, z), Vec3(x, y + 0.08, z - 0.8), Vec3(x, y, z - 0.8)},
+          -Vec3::UnitX(), true);
+      post.material.albedo = sways ? 0.6f : 0.9f;  // in a batch of its own
+      if (sways) post.sway = {{0.f, 0.f}, {0.f, 0.f}, {3.f, 0.5f}, {3.f, 0.5f}};
+      scene.meshes.push_back(post);
+    }
+  WindOptions wind;
+  wind.speed_mps = 8;
+  wind.direction_deg = 90;  // across the view: posts at its edges sway in and out of it
+  std::vector<GrayImage> images;
+  std::vector<std::vector<float>> depths;
+  std::vector<std::size_t> sent;
+  for (const bool cull : {true, false}) {
+    StereoRenderer r(rig_640(), RenderOptions{});
+    r.upload(scene);
+    r.set_sway(vegetation_sway(wind, Rng(5)));
+    r.set_run_culling(cull);
+    for (int k = 0; k < 20; ++k) {
+      const double yaw_deg = k < 3 ? -21.0 + 24 * k : -3.0 + 0.25 * (k - 3);
+      const Mat3 R = Eigen::AngleAxisd(deg2rad(yaw_deg), Vec3::UnitZ()).toRotationMatrix();
+      const SE3 T_W_C(R * R_frd_optical(), Vec3(0, 0, -0.5));
+      for (double t : {0.4, 3.3}) {
+        const StereoImages pair = r.render(T_W_C, t, false);
+        images.push_back(pair.left);
+        images.push_back(pair.right);
+        depths.push_back(r.render_truth(T_W_C, t).depth.depth_m);
+      }
+    }
+    sent.push_back(r.triangles_submitted());
+  }
+  const std::size_t n = depths.size() / 2;
+  int differ = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    differ += images[2 * k].pixels != images[2 * (k + n)].pixels;
+    differ += images[2 * k + 1].pixels != images[2 * (k + n) + 1].pixels;
+    differ += depths[k] != depths[k + n];
+  }
+  EXPECT_EQ(differ, 0);
+  // Culling sent fewer than half the triangles: each pass (two mirror images, two eyes, the
+  // truth) sees 8 to 12 m of each row's 48.
+  EXPECT_LT(static_cast<double>(sent[0]), 0.5 * static_cast<double>(sent[1]));
+  EXPECT_GT(sent[0], 0u);
+}
+
 // A rolling-shutter image, band by band, against its second method: each band's rows cut out of
 // a whole frame rendered at that band's pose and time. The bands draw only the rows of their
 // mirror images that their rows read (StereoRenderer::Impl::reflection_rows), so steep waves,
