@@ -87,6 +87,17 @@ bool sphere_visible(const std::array<Eigen::Vector4f, 6>& planes, const Eigen::V
   return true;
 }
 
+// The axis-aligned box of the vertices added, and the sphere around it.
+struct Box {
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = -lo;
+  void add(const Vertex& v) {
+    lo = lo.cwiseMin(Eigen::Vector3f(v.x, v.y, v.z));
+    hi = hi.cwiseMax(Eigen::Vector3f(v.x, v.y, v.z));
+  }
+  Eigen::Vector3f centre() const { return 0.5f * (lo + hi); }
+  float radius() const { return 0.5f * (hi - lo).norm(); }
+};
+
 // A mesh's triangles in runs of kRunTriangles, each with a sphere holding its vertices (grown
 // by a part in 10^4 and a millimetre against rounding).
 std::vector<GpuMesh::Run> triangle_runs(const Mesh& mesh) {
@@ -94,14 +105,10 @@ std::vector<GpuMesh::Run> triangle_runs(const Mesh& mesh) {
   std::vector<GpuMesh::Run> runs;
   for (std::size_t first = 0; first < mesh.indices.size(); first += 3 * kRunTriangles) {
     const std::size_t end = std::min(mesh.indices.size(), first + 3 * kRunTriangles);
-    Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = -lo;
-    for (std::size_t k = first; k < end; ++k) {
-      const Vertex& v = mesh.vertices[mesh.indices[k]];
-      lo = lo.cwiseMin(Eigen::Vector3f(v.x, v.y, v.z));
-      hi = hi.cwiseMax(Eigen::Vector3f(v.x, v.y, v.z));
-    }
-    runs.push_back({0.5f * (lo + hi), 0.5f * (hi - lo).norm() * 1.0001f + 1e-3f,
-                    static_cast<GLsizei>(first), static_cast<GLsizei>(end - first)});
+    Box box;
+    for (std::size_t k = first; k < end; ++k) box.add(mesh.vertices[mesh.indices[k]]);
+    runs.push_back({box.centre(), box.radius() * 1.0001f + 1e-3f, static_cast<GLsizei>(first),
+                    static_cast<GLsizei>(end - first)});
   }
   return runs;
 }
@@ -482,12 +489,9 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     for (std::uint32_t i : x.indices)
       if (i >= x.vertices.size())
         throw InternalError(fmt::format("renderer: mesh '{}' has an index out of range", x.name));
-    Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = -lo;
-    for (const Vertex& v : x.vertices) {
-      lo = lo.cwiseMin(Eigen::Vector3f(v.x, v.y, v.z));
-      hi = hi.cwiseMax(Eigen::Vector3f(v.x, v.y, v.z));
-    }
-    const Eigen::Vector3f c = 0.5f * (lo + hi);
+    Box box;
+    for (const Vertex& v : x.vertices) box.add(v);
+    const Eigen::Vector3f c = box.centre();
     const auto key = std::make_tuple(
         x.material.texture, x.material.albedo, x.material.specular, x.material.double_sided,
         std::lround(std::floor(c.x() / kBatchCell_m)),
@@ -512,13 +516,10 @@ void StereoRenderer::upload(const SceneGeometry& scene) {
     g.mover = mesh.mover;
     g.cutout = mesh.material.texture >= 0 &&
                !scene.textures[static_cast<std::size_t>(mesh.material.texture)].alpha.empty();
-    Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e30f), hi = -lo;
-    for (const Vertex& v : mesh.vertices) {
-      lo = lo.cwiseMin(Eigen::Vector3f(v.x, v.y, v.z));
-      hi = hi.cwiseMax(Eigen::Vector3f(v.x, v.y, v.z));
-    }
-    g.centre = 0.5f * (lo + hi);
-    g.radius = 0.5f * (hi - lo).norm();
+    Box box;
+    for (const Vertex& v : mesh.vertices) box.add(v);
+    g.centre = box.centre();
+    g.radius = box.radius();
     g.runs = triangle_runs(mesh);
     glGenVertexArrays(1, &g.vao);
     glBindVertexArray(g.vao);
