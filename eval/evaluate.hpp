@@ -17,6 +17,7 @@
 #include "eval/association.hpp"
 #include "eval/eval_options.hpp"
 #include "eval/kitti_segments.hpp"
+#include "eval/paper_attitude.hpp"
 #include "eval/regression.hpp"
 #include "eval/sections.hpp"
 #include "eval/track.hpp"
@@ -35,6 +36,9 @@ struct EvaluationInput {
   /// name its table goes by.
   std::optional<PlanarReference> basin_reference;
   std::string basin_reference_name = "overhead camera";
+  /// The attitude reference the river paper compared the VO's angles with (its x-IMU), for
+  /// Table 1's angle rows as the paper computed them.
+  std::optional<AttitudeReference> attitude_reference;
 };
 
 struct SubtrackEvaluation {
@@ -66,6 +70,8 @@ struct Evaluation {
   std::string basin_reference_name;
   std::size_t basin_reference_pairs = 0;
   std::vector<KittiSegmentResult> kitti;
+  /// Table 1's angle rows and Section 3.2's maxima against `EvaluationInput::attitude_reference`.
+  std::optional<PaperAttitude> paper_attitude;
   std::vector<std::string> warnings;
 
   /// One paragraph: pairs, APE RMSE, sections, regression R^2.

@@ -256,6 +256,7 @@ std::vector<Track> make_tracks(const Scenario& sc, const StereoRig& rig,
 std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks,
                             const MissionTruth& mission, const std::vector<double>& moving_px,
                             const std::optional<eval::PlanarReference>& overhead,
+                            const std::optional<eval::AttitudeReference>& ahrs,
                             TrackRecords* records, std::string* sections_csv) {
   const Trajectory& camera_gt = mission.camera_gt;
   const std::vector<EulerZYX>& platform = mission.platform;
@@ -272,6 +273,7 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
     in.algorithm = tr.name;
     in.options = sc.eval;
     in.basin_reference = overhead;
+    in.attitude_reference = ahrs;
     eval::FrameTable ft;
     // `lost`: 1 where the VO gave no motion, so each section's mean is its share of such
     // frames (the sections a lost stretch touched). The frames the camera delivered, as in
@@ -540,7 +542,16 @@ static VisionRecord run_vision_stages(const Scenario& sc, const sim::SceneGeomet
   // camera's reference).
   std::string report = fmt::format("# driftlab run: {}\n\n{}\n\n", sc.name, sc.description);
   std::string sections;
-  report += evaluate_tracks(sc, tracks, mission, moving_px, overhead, &record.tracks, &sections);
+  std::optional<eval::AttitudeReference> ahrs;
+  if (!sensor_data.ahrs.empty()) {
+    ahrs.emplace();
+    for (const sim::AhrsSample& a : sensor_data.ahrs) {
+      ahrs->t_ns.push_back(a.t_ns);
+      ahrs->euler.push_back(a.euler);
+    }
+  }
+  report +=
+      evaluate_tracks(sc, tracks, mission, moving_px, overhead, ahrs, &record.tracks, &sections);
   write_file_atomic(dir / "sections.csv", sections);
   report += report_tracking(tracks, camera_gt, &record.tracks, &warnings);
   report += compare_filters_with_raw_vo(tracks, &record.tracks, &warnings);

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/rng.hpp"
+#include "core/rotation.hpp"
 #include "scenes/sky_obstruction.hpp"
 
 namespace driftlab::pipeline {
@@ -41,8 +42,10 @@ struct SensorStage::Impl {
   RngStreams rng;
   std::unique_ptr<sim::ImuSimulator> imu;
   std::unique_ptr<sim::ImuCsvWriter> imu_csv;
-  std::vector<TimeNs> imu_times, gps_times, compass_times;
-  std::size_t imu_next = 0, gps_next = 0, compass_next = 0;
+  std::unique_ptr<sim::AhrsSimulator> ahrs;
+  std::unique_ptr<sim::AhrsCsvWriter> ahrs_csv;
+  std::vector<TimeNs> imu_times, gps_times, compass_times, ahrs_times;
+  std::size_t imu_next = 0, gps_next = 0, compass_next = 0, ahrs_next = 0;
   std::vector<sim::BodySample> gps_bodies, compass_bodies;
   std::vector<std::pair<TimeNs, ImuBias>> imu_biases;  // after each IMU sample, dropped ones too
   SensorData data;
@@ -51,6 +54,11 @@ struct SensorStage::Impl {
     if (sc.sensors.imu.enabled) {
       imu = std::make_unique<sim::ImuSimulator>(sc.sensors.imu, rng, "imu");
       imu_csv = std::make_unique<sim::ImuCsvWriter>(dir / "imu.csv");
+    }
+    if (sc.sensors.ahrs.enabled) {
+      ahrs = std::make_unique<sim::AhrsSimulator>(
+          sc.sensors.ahrs, sim::earth_field_ned_nt(sc.sensors.compass), rng, "ahrs");
+      ahrs_csv = std::make_unique<sim::AhrsCsvWriter>(dir / "ahrs.csv");
     }
   }
 };
@@ -67,11 +75,15 @@ std::vector<TimeNs> SensorStage::sample_times(double end_s) const {
   s.gps_times = o.gps.enabled ? sim::sample_times(o.gps.rate_hz, end_s) : std::vector<TimeNs>{};
   s.compass_times =
       o.compass.enabled ? sim::sample_times(o.compass.rate_hz, end_s) : std::vector<TimeNs>{};
+  s.ahrs_times =
+      o.ahrs.enabled ? sim::sample_times(o.ahrs.update_rate_hz, end_s) : std::vector<TimeNs>{};
   std::vector<TimeNs> all;
-  all.reserve(s.imu_times.size() + s.gps_times.size() + s.compass_times.size());
+  all.reserve(s.imu_times.size() + s.gps_times.size() + s.compass_times.size() +
+              s.ahrs_times.size());
   all.insert(all.end(), s.imu_times.begin(), s.imu_times.end());
   all.insert(all.end(), s.gps_times.begin(), s.gps_times.end());
   all.insert(all.end(), s.compass_times.begin(), s.compass_times.end());
+  all.insert(all.end(), s.ahrs_times.begin(), s.ahrs_times.end());
   std::sort(all.begin(), all.end());
   all.erase(std::unique(all.begin(), all.end()), all.end());
   return all;
@@ -86,6 +98,11 @@ void SensorStage::on_sample(const sim::BodySample& b) {
     }
     s.imu_biases.push_back({b.t_ns, {s.imu->gyro().bias, s.imu->accel().bias}});
   }
+  if (s.ahrs && take(s.ahrs_times, &s.ahrs_next, b.t_ns))
+    if (const auto a = s.ahrs->update(b)) {
+      s.ahrs_csv->write(*a);
+      s.data.ahrs.push_back(*a);
+    }
   if (take(s.gps_times, &s.gps_next, b.t_ns)) s.gps_bodies.push_back(b);
   if (take(s.compass_times, &s.compass_next, b.t_ns)) s.compass_bodies.push_back(b);
 }
@@ -111,7 +128,23 @@ SensorData SensorStage::finish(const sim::SceneGeometry* scene) {
   release(&s.imu_times);
   release(&s.gps_times);
   release(&s.compass_times);
+  release(&s.ahrs_times);
   release(&s.imu_biases);
+  if (s.ahrs_csv) {
+    s.ahrs_csv->commit();
+    double sq[3] = {0, 0, 0};
+    for (const sim::AhrsSample& a : s.data.ahrs) {
+      sq[0] += std::pow(wrap_angle_rad(a.euler.roll_rad - a.true_euler.roll_rad), 2);
+      sq[1] += std::pow(wrap_angle_rad(a.euler.pitch_rad - a.true_euler.pitch_rad), 2);
+      sq[2] += std::pow(wrap_angle_rad(a.euler.yaw_rad - a.true_euler.yaw_rad), 2);
+    }
+    const double n = std::max<double>(1.0, static_cast<double>(s.data.ahrs.size()));
+    stats["ahrs"] = {{"samples", s.data.ahrs.size()},
+                     {"rate_hz", s.sc.sensors.ahrs.rate_hz},
+                     {"roll_rmse_deg", rad2deg(std::sqrt(sq[0] / n))},
+                     {"pitch_rmse_deg", rad2deg(std::sqrt(sq[1] / n))},
+                     {"yaw_rmse_deg", rad2deg(std::sqrt(sq[2] / n))}};
+  }
   s.data.imu.shrink_to_fit();
   if (s.sc.sensors.gps.enabled) {
     std::unique_ptr<scenes::MeshSkyObstruction> sky;

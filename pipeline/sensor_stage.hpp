@@ -1,8 +1,9 @@
-// The sensors stage of a run: IMU, GPS and compass measured from the same ground truth as the
-// cameras (sim/sensors), written as imu.csv, gps.csv and compass.csv (docs/design.md, "Data
-// contract of a run") and kept for the filters. The IMU streams during the physics; GPS and
-// compass wait for the scene (its meshes hide satellites, its steel structures bend the
-// magnetic field), so the body states at their (few) sample times are kept until finish().
+// The sensors stage of a run: IMU, GPS, compass and AHRS measured from the same ground truth as the
+// cameras (sim/sensors), written as imu.csv, gps.csv, compass.csv and ahrs.csv (docs/design.md,
+// "Data contract of a run") and kept for the filters. The IMU streams during the physics; GPS and
+// compass wait for the scene (the AHRS streams like the IMU) (its meshes hide satellites, its steel
+// structures bend the magnetic field), so the body states at their (few) sample times are kept
+// until finish().
 #pragma once
 
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include "core/trajectory_io.hpp"
 #include "pipeline/scenario.hpp"
 #include "sim/render/scene_geometry.hpp"
+#include "sim/sensors/ahrs.hpp"
 #include "sim/sensors/compass.hpp"
 #include "sim/sensors/gps.hpp"
 #include "sim/sensors/imu.hpp"
@@ -28,7 +30,8 @@ struct SensorData {
   std::vector<ImuSample> imu;
   std::vector<sim::GpsFix> gps;
   std::vector<sim::CompassSample> compass;
-  nlohmann::json stats;  ///< per sensor: samples, and for the GPS the sky statistics
+  std::vector<sim::AhrsSample> ahrs;  ///< the attitude reference (evaluation only, never a filter)
+  nlohmann::json stats;               ///< per sensor: samples, and for the GPS the sky statistics
 };
 
 class SensorStage {
