@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "core/rotation.hpp"
 #include "sim/sensors/csv_detail.hpp"
+#include "sim/sensors/imu.hpp"
 
 namespace driftlab::sim {
 
@@ -58,6 +59,23 @@ CompassSimulator::CompassSimulator(const CompassOptions& options, const RngStrea
       heading_noise_(rng.stream(name + ".heading_noise")),
       clock_(options.clock, rng, name) {}
 
+CompassSimulator::Levelling CompassSimulator::levelling(const BodySample& b,
+                                                        const EulerZYX& truth) const {
+  switch (options_.levelling) {
+    case CompassLevelling::kTrueAttitude:
+      return {truth.roll_rad, truth.pitch_rad};
+    case CompassLevelling::kAccelerometer: {
+      // At rest the specific force is -g along the sensor's down: f = (g sin(pitch),
+      // -g sin(roll) cos(pitch), -g cos(roll) cos(pitch)); any acceleration tilts it.
+      const Vec3 f = ideal_imu(b, mount_).accel_m_s2;
+      return {std::atan2(-f.y(), -f.z()), std::atan2(f.x(), std::hypot(f.y(), f.z()))};
+    }
+    case CompassLevelling::kNone:
+      return {0.0, 0.0};
+  }
+  return {truth.roll_rad, truth.pitch_rad};
+}
+
 std::optional<CompassSample> CompassSimulator::measure(const BodySample& b) {
   const Quat q_W_S = b.state.q_W_B * Quat(mount_.R_B_S);
   const Vec3 p_W = b.state.p_W + b.state.q_W_B * mount_.p_B;
@@ -69,6 +87,7 @@ std::optional<CompassSample> CompassSimulator::measure(const BodySample& b) {
   const Vec3 world = earth_W_ + anomaly_field_ned_nt(options_.anomalies, p_W);
   const Vec3 distorted = soft_iron_ * (q_W_S.conjugate() * world) + hard_iron_;
   const EulerZYX e = euler_zyx_from_quat(q_W_S);
+  const Levelling level = levelling(b, e);
 
   CompassSample s;
   s.true_heading_rad = e.yaw_rad;
@@ -76,9 +95,10 @@ std::optional<CompassSample> CompassSimulator::measure(const BodySample& b) {
   for (int i = 0; i < 3; ++i) s.field_S_nt[i] += options_.field_noise_nt * field_noise_.normal();
   // The heading comes from the distorted but noise-free field: its noise is
   // sigma_deg by definition, not a by-product of field_noise_nt.
-  s.heading_rad = wrap_angle_rad(tilt_compensated_heading_rad(distorted, e.roll_rad, e.pitch_rad,
-                                                              deg2rad(options_.declination_deg)) +
-                                 deg2rad(options_.sigma_deg) * heading_noise_.normal());
+  s.heading_rad =
+      wrap_angle_rad(tilt_compensated_heading_rad(distorted, level.roll_rad, level.pitch_rad,
+                                                  deg2rad(options_.declination_deg)) +
+                     deg2rad(options_.sigma_deg) * heading_noise_.normal());
   const SampleTime t = clock_.stamp(b.t_ns);
   if (t.dropped) return std::nullopt;
   s.t_ns = t.t_stamp_ns;

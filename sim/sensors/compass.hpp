@@ -3,8 +3,10 @@
 // paper names steel sheet piling as a source of compass bias), then hard- and
 // soft-iron errors of the installation and white noise, in the sensor frame.
 // The heading is what a tilt-compensated compass computes from that distorted
-// field, with the declination applied (so a clean compass reports true heading),
-// plus heading noise of sigma_deg.
+// field, levelled with the roll and pitch that `levelling` names (the true ones, the
+// apparent gravity of the compass's own accelerometer, or none), with the declination
+// applied (so a clean, truly levelled compass reports true heading), plus heading noise
+// of sigma_deg.
 #pragma once
 
 #include <filesystem>
@@ -14,6 +16,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/rng.hpp"
+#include "core/rotation.hpp"
 #include "core/time.hpp"
 #include "sim/sensors/clock.hpp"
 #include "sim/sensors/csv_detail.hpp"
@@ -58,6 +61,13 @@ class CompassSimulator {
   const SensorMount& mount() const { return mount_; }
 
  private:
+  struct Levelling {
+    double roll_rad, pitch_rad;
+  };
+  /// The roll and pitch that level the field (CompassOptions::levelling); `truth`: the
+  /// sensor's true angles.
+  Levelling levelling(const BodySample& b, const EulerZYX& truth) const;
+
   CompassOptions options_;
   SensorMount mount_;
   Vec3 earth_W_;

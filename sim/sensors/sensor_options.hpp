@@ -606,8 +606,20 @@ struct MagneticAnomalyOptions {
   }
 };
 
+/// Where a compass takes the roll and pitch that level its field before the heading: the true
+/// attitude (a perfectly levelled compass), its own accelerometer's specific force (a
+/// strapdown compass: apparent gravity, tilted by every acceleration of the hull), or none
+/// (a plain two-axis heading of the sensor-frame field).
+enum class CompassLevelling { kTrueAttitude, kAccelerometer, kNone };
+constexpr auto enum_table(CompassLevelling) {
+  return std::array{std::pair{CompassLevelling::kTrueAttitude, "true_attitude"},
+                    std::pair{CompassLevelling::kAccelerometer, "accelerometer"},
+                    std::pair{CompassLevelling::kNone, "none"}};
+}
+
 struct CompassOptions {
   bool enabled = true;
+  CompassLevelling levelling = CompassLevelling::kTrueAttitude;
   double rate_hz = 10.0;
   double sigma_deg = 1.0;
   MountOptions mount;
@@ -631,6 +643,10 @@ struct CompassOptions {
   void visit(A& a) {
     a("enabled", enabled, "Simulate the compass / magnetometer");
     a("rate_hz", rate_hz, "Sample rate [Hz]", yaml::in_range(0.01, 1000) & yaml::positive());
+    a("levelling", levelling,
+      "Roll and pitch that level the field before the heading: true_attitude (exact), "
+      "accelerometer (from the specific force at the compass: a strapdown compass, tilted by "
+      "the hull's accelerations) or none (the heading of the sensor-frame field)");
     a("sigma_deg", sigma_deg,
       "Heading noise standard deviation, added to the heading computed from the (distorted) "
       "field [deg]",

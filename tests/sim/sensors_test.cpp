@@ -273,6 +273,41 @@ TEST(CompassSensor, CleanCompassReportsTrueHeadingAtAnyTilt) {
   }
 }
 
+TEST(CompassSensor, AStrapdownCompassLevelsWithTheApparentGravity) {
+  // Level, heading east, accelerating forward at a: the accelerometer's apparent gravity
+  // reads a pitch of atan(a / g), and levelling with it turns the vertical field Z into the
+  // heading: atan2(H, Z sin(theta)) instead of 90 deg (written out by hand). Levelled with
+  // the true attitude, or at rest, the heading is exact; a compass that does not level at all
+  // reads the same on a level hull.
+  CompassOptions o;
+  o.sigma_deg = 0;
+  o.field_noise_nt = 0;
+  o.declination_deg = 0;
+  o.inclination_deg = 66;
+  BodySample b = pose(0, 0, 90 * kDeg, Vec3::Zero());
+  const double a = 0.3;
+  b.v_dot_B = Vec3(a, 0, 0);
+  const double H = 49000 * std::cos(66 * kDeg), Z = 49000 * std::sin(66 * kDeg);
+  const double theta = std::atan(a / kSensorsG);
+  o.levelling = CompassLevelling::kAccelerometer;
+  EXPECT_NEAR(CompassSimulator(o, RngStreams(1)).measure(b)->heading_rad,
+              std::atan2(H, Z * std::sin(theta)), 1e-9);
+  EXPECT_LT(std::atan2(H, Z * std::sin(theta)), 89 * kDeg);  // over a degree off
+  EXPECT_NEAR(
+      CompassSimulator(o, RngStreams(1)).measure(pose(0, 0, 90 * kDeg, Vec3::Zero()))->heading_rad,
+      90 * kDeg, 1e-9);
+  o.levelling = CompassLevelling::kTrueAttitude;
+  EXPECT_NEAR(CompassSimulator(o, RngStreams(1)).measure(b)->heading_rad, 90 * kDeg, 1e-9);
+  o.levelling = CompassLevelling::kNone;
+  EXPECT_NEAR(CompassSimulator(o, RngStreams(1)).measure(b)->heading_rad, 90 * kDeg, 1e-9);
+  // ... but a heeled one reads the vertical field as horizontal: rolled 5 deg, heading north,
+  // the sensor's y axis dips and sees Z sin(5 deg).
+  const double roll = 5 * kDeg;
+  EXPECT_NEAR(
+      CompassSimulator(o, RngStreams(1)).measure(pose(roll, 0, 0, Vec3::Zero()))->heading_rad,
+      std::atan2(-Z * std::sin(roll), H), 1e-9);
+}
+
 TEST(CompassSensor, HardAndSoftIronDistortTheFieldAndTheHeading) {
   CompassOptions o;
   o.sigma_deg = 0;
