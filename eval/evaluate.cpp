@@ -473,7 +473,7 @@ std::string tables_markdown(const Evaluation& e, const EvalOptions& options) {
         "\nThe last three rows compare, as the river paper did, the AHRS's Euler angles in its "
         "own frame with the VO's in its first camera's frame; along the whole track their "
         "difference strays at most {} (roll), {} (pitch) and {} (yaw) deg from its start "
-        "(the paper's Section 3.2 maxima).\n",
+        "(the paper's Section 3.1 maxima).\n",
         fixed(rad2deg(a.max_abs_rad.roll_rad), 2), fixed(rad2deg(a.max_abs_rad.pitch_rad), 2),
         fixed(rad2deg(a.max_abs_rad.yaw_rad), 2));
   }

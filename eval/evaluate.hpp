@@ -70,7 +70,7 @@ struct Evaluation {
   std::string basin_reference_name;
   std::size_t basin_reference_pairs = 0;
   std::vector<KittiSegmentResult> kitti;
-  /// Table 1's angle rows and Section 3.2's maxima against `EvaluationInput::attitude_reference`.
+  /// Table 1's angle rows and Section 3.1's maxima against `EvaluationInput::attitude_reference`.
   std::optional<PaperAttitude> paper_attitude;
   std::vector<std::string> warnings;
 

@@ -3,7 +3,7 @@
 // angles an AHRS (the x-IMU) reported in its own frame and n_VO the VO's angles in its first
 // camera's frame, with no alignment between the two frames. Over each 6.5 m section the change
 // of eps, divided by the section's length, is Table 1's e'_roll, e'_pitch and e'_yaw; along the
-// whole track, eps's largest excursion from its start is Section 3.2's maximum error.
+// whole track, eps's largest excursion from its start is Section 3.1's maximum error.
 //
 // The exact errors (sections.hpp) compare the VO's relative rotation with the true one in the
 // same camera axes. These do not: a camera tilted against the AHRS's level turns part of every

@@ -199,58 +199,70 @@ std::vector<std::string> twin_stats_cells(const nlohmann::json& d, const char* s
 
 const std::vector<std::string> kStatRows{"Min", "Mean", "Median", "SD", "Max", "n"};
 
-bool any_paper_attitude(const nlohmann::json& m, const std::vector<std::string>& twins) {
+// A row of mean (SD) cells: the paper's statistics and the run's at `algorithms.A.GROUP.KEY`.
+struct MeanSdRow {
+  const char* name;
+  Stats PaperColumn::*paper;
+  const char* key;
+};
+
+template <std::size_t N>
+std::string mean_sd_table(const nlohmann::json& m, const std::vector<std::string>& twins,
+                          const std::array<MeanSdRow, N>& rows, const char* group) {
+  std::vector<std::string> names;
+  for (const MeanSdRow& r : rows) names.push_back(std::string(r.name) + ", mean (SD)");
+  return table(names,
+               columns(
+                   twins,
+                   [&](const PaperColumn& p) {
+                     std::vector<std::string> c;
+                     for (const MeanSdRow& r : rows)
+                       c.push_back(num((p.*r.paper).mean) + " (" + num((p.*r.paper).sd) + ")");
+                     return c;
+                   },
+                   [&](const std::string& a) {
+                     std::vector<std::string> c;
+                     for (const MeanSdRow& r : rows) {
+                       const auto& d = sub(m, {"algorithms", a, group, r.key});
+                       c.push_back(num(at(d, {"mean"})) + " (" + num(at(d, {"sd"})) + ")");
+                     }
+                     return c;
+                   }));
+}
+
+// The columns with the paper's attitude comparison: not the (prism) ones, whose truth differs
+// from the camera's in position only.
+std::vector<std::string> attitude_twins(const nlohmann::json& m,
+                                        const std::vector<std::string>& twins) {
+  std::vector<std::string> out;
   for (const std::string& a : twins)
-    if (!sub(m, {"algorithms", a, "paper_attitude"}).is_null()) return true;
-  return false;
+    if (!at_prism(a) && !sub(m, {"algorithms", a, "paper_attitude"}).is_null()) out.push_back(a);
+  return out;
 }
 
 // Table 1's angle rows as the paper computed them (Eq. (11)): the run's AHRS against the VO's
 // angles in its first camera's frame. The paper's cells are its Table 1, computed that way.
-std::string paper_attitude_rows(const nlohmann::json& m, const std::vector<std::string>& twins) {
-  if (!any_paper_attitude(m, twins)) return "";
-  struct Row {
-    const char* name;
-    Stats PaperColumn::*paper;
-    const char* key;
-  };
-  const std::array<Row, 3> rows{
+std::string paper_attitude_rows(const nlohmann::json& m, const std::vector<std::string>& all) {
+  const std::vector<std::string> twins = attitude_twins(m, all);
+  if (twins.empty()) return "";
+  const std::array<MeanSdRow, 3> rows{
       {{"e'_roll, AHRS − VO (deg/m)", &PaperColumn::roll, "roll_deg_per_m"},
        {"e'_pitch, AHRS − VO (deg/m)", &PaperColumn::pitch, "pitch_deg_per_m"},
        {"e'_yaw, AHRS − VO (deg/m)", &PaperColumn::yaw, "yaw_deg_per_m"}}};
-  std::vector<std::string> names;
-  for (const Row& r : rows) names.push_back(std::string(r.name) + ", mean (SD)");
-  std::string out =
-      "The angle rows above compare the VO's rotation with the true one in the same camera "
-      "axes. The paper compared the x-IMU's Euler angles in its own frame with the VO's in its "
-      "first camera's frame (Eq. (11)); the twin's AHRS (`sensors.ahrs`) compared the same "
-      "way:\n\n";
-  out +=
-      table(names, columns(
-                       twins,
-                       [&](const PaperColumn& p) {
-                         std::vector<std::string> c;
-                         for (const Row& r : rows)
-                           c.push_back(num((p.*r.paper).mean) + " (" + num((p.*r.paper).sd) + ")");
-                         return c;
-                       },
-                       [&](const std::string& a) {
-                         std::vector<std::string> c;
-                         for (const Row& r : rows) {
-                           const auto& d = sub(m, {"algorithms", a, "paper_attitude", r.key});
-                           c.push_back(num(at(d, {"mean"})) + " (" + num(at(d, {"sd"})) + ")");
-                         }
-                         return c;
-                       }));
-  return out;
+  return "The angle rows above compare the VO's rotation with the true one in the same camera "
+         "axes. The paper compared the x-IMU's Euler angles in its own frame with the VO's in "
+         "its first camera's frame (Eq. (11)); the twin's AHRS (`sensors.ahrs`) compared the "
+         "same way:\n\n" +
+         mean_sd_table(m, twins, rows, "paper_attitude");
 }
 
-// Section 3.2: the largest pitch and roll errors over the four crossings, compared as the
+// Section 3.1: the largest pitch and roll errors over the four crossings, compared as the
 // paper compared them (sparse 17.78 and 13.88 deg, dense 45.48 and 40.56 deg).
-std::string attitude_maxima(const nlohmann::json& m, const std::vector<std::string>& twins) {
-  if (!any_paper_attitude(m, twins)) return "";
+std::string attitude_maxima(const nlohmann::json& m, const std::vector<std::string>& all) {
+  const std::vector<std::string> twins = attitude_twins(m, all);
+  if (twins.empty()) return "";
   std::string out =
-      "## Section 3.2. Largest pitch and roll errors along the track, AHRS − VO (deg)\n\n";
+      "## Section 3.1. Largest pitch and roll errors along the track, AHRS − VO (deg)\n\n";
   out += table(
       {"pitch", "roll"},
       columns(
@@ -278,36 +290,13 @@ std::string table1(const nlohmann::json& m, const std::vector<std::string>& twin
           }));
   // The components: mean and SD (each work defines its axes: the twin's x is
   // the optical axis, y right, z down).
-  struct Row {
-    const char* name;
-    Stats PaperColumn::*paper;
-    const char* key;
-  };
-  const std::array<Row, 6> rows{{{"e'_x (m/m)", &PaperColumn::x, "x_m_per_m"},
-                                 {"e'_y (m/m)", &PaperColumn::y, "y_m_per_m"},
-                                 {"e'_z (m/m)", &PaperColumn::z, "z_m_per_m"},
-                                 {"e'_roll (deg/m)", &PaperColumn::roll, "roll_deg_per_m"},
-                                 {"e'_pitch (deg/m)", &PaperColumn::pitch, "pitch_deg_per_m"},
-                                 {"e'_yaw (deg/m)", &PaperColumn::yaw, "yaw_deg_per_m"}}};
-  std::vector<std::string> names;
-  for (const Row& r : rows) names.push_back(std::string(r.name) + ", mean (SD)");
-  out +=
-      table(names, columns(
-                       twins,
-                       [&](const PaperColumn& p) {
-                         std::vector<std::string> c;
-                         for (const Row& r : rows)
-                           c.push_back(num((p.*r.paper).mean) + " (" + num((p.*r.paper).sd) + ")");
-                         return c;
-                       },
-                       [&](const std::string& a) {
-                         std::vector<std::string> c;
-                         for (const Row& r : rows) {
-                           const auto& d = sub(m, {"algorithms", a, "sections", r.key});
-                           c.push_back(num(at(d, {"mean"})) + " (" + num(at(d, {"sd"})) + ")");
-                         }
-                         return c;
-                       }));
+  const std::array<MeanSdRow, 6> rows{{{"e'_x (m/m)", &PaperColumn::x, "x_m_per_m"},
+                                       {"e'_y (m/m)", &PaperColumn::y, "y_m_per_m"},
+                                       {"e'_z (m/m)", &PaperColumn::z, "z_m_per_m"},
+                                       {"e'_roll (deg/m)", &PaperColumn::roll, "roll_deg_per_m"},
+                                       {"e'_pitch (deg/m)", &PaperColumn::pitch, "pitch_deg_per_m"},
+                                       {"e'_yaw (deg/m)", &PaperColumn::yaw, "yaw_deg_per_m"}}};
+  out += mean_sd_table(m, twins, rows, "sections");
   out += paper_attitude_rows(m, twins);
   return out;
 }

@@ -72,6 +72,38 @@ TEST(PaperCompare, PaperAndTwinColumnsSideBySideWithTheRightTrack) {
   EXPECT_EQ(discharge.find("13.36 (2.01)"), std::string::npos);
 }
 
+// A run with the AHRS: Table 1's angle rows as the paper computed them beside the exact ones,
+// and on the discharge track the largest pitch and roll errors, with the paper's; a (prism)
+// column, whose truth differs only in position, gets none. A run without it shows neither.
+TEST(PaperCompare, TheAttitudeAsThePaperComparedItWhenTheRunHasAnAhrs) {
+  nlohmann::json m;
+  m["scenario"] = "river_crossing";
+  m["algorithms"]["sparse"] = algorithm(0.0456, 0.001);
+  m["algorithms"]["sparse (prism)"] = algorithm(0.0789, 0.001);
+  const std::string without = river_paper_side_by_side(m, RiverPaperTrack::kDischarge);
+  EXPECT_EQ(without.find("AHRS"), std::string::npos);
+  nlohmann::json& a = m["algorithms"]["sparse"]["paper_attitude"];
+  a["roll_deg_per_m"] = stats(-2, 0.012, 0.0, 1.234, 2, 12);
+  a["pitch_deg_per_m"] = stats(-2, -0.021, 0.0, 0.987, 2, 12);
+  a["yaw_deg_per_m"] = stats(-1, 0.003, 0.0, 0.321, 1, 12);
+  a["max_abs_deg"] = {{"roll", 12.345}, {"pitch", 23.456}, {"yaw", 3.0}};
+  const std::string with = river_paper_side_by_side(m, RiverPaperTrack::kDischarge);
+  EXPECT_NE(with.find("| e'_roll, AHRS − VO (deg/m), mean (SD) | 0.000 (1.250) | 0.012 (1.234) |"),
+            std::string::npos)
+      << with;
+  EXPECT_NE(
+      with.find("| e'_pitch, AHRS − VO (deg/m), mean (SD) | -0.010 (1.390) | -0.021 (0.987) |"),
+      std::string::npos);
+  EXPECT_NE(with.find("| pitch | 17.78 | 23.46 | 45.48 |"), std::string::npos) << with;
+  EXPECT_NE(with.find("| roll | 13.88 | 12.35 | 40.56 |"), std::string::npos) << with;
+  // The exact rows stay as they were.
+  EXPECT_NE(with.find("| e'_roll (deg/m), mean (SD) | 0.000 (1.250) | 0.004 (0.050) |"),
+            std::string::npos);
+  // The total trajectory has no maxima in the paper.
+  EXPECT_EQ(river_paper_side_by_side(m, RiverPaperTrack::kTotal).find("| pitch | 17.78"),
+            std::string::npos);
+}
+
 // A run whose truth is a point away from the camera (eval.reference_point_m) says so; one
 // measured at the camera, or from before the key existed, says nothing.
 TEST(PaperCompare, SaysWhereTheTruthWasMeasuredWhenNotAtTheCamera) {
