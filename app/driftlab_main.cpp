@@ -83,6 +83,7 @@ struct EvalArgs {
   std::string vo;  // which of a run's VOs --covariates' columns to read (default: from the name)
   std::string regress = "v,h,f,d";
   std::string reference_point = "0,0,0";
+  std::string attitude_reference;  // an AHRS's angles (a run's ahrs.csv): the paper's Eq. (11)
   double section_length_m = 6.5;
   double length_sample_m = 0.5;
   double max_diff_s = 0.02;
@@ -145,13 +146,18 @@ int eval_command(const EvalArgs& a) {
   in.est_label = a.est;
   in.algorithm = a.name.empty() ? fs::path(a.est).stem().string() : a.name;
   if (!a.covariates.empty()) in.frames = read_covariates(a, in.algorithm);
+  if (!a.attitude_reference.empty())
+    in.attitude_reference = eval::read_attitude_reference(a.attitude_reference);
   const eval::Evaluation e = eval::evaluate(in);
 
   driftlab::AtomicDirectory dir(a.out, a.force);
   nlohmann::json metrics;
   metrics["version"] = DRIFTLAB_VERSION;
-  metrics["inputs"] = {
-      {"gt", a.gt}, {"est", a.est}, {"format", a.format}, {"covariates", a.covariates}};
+  metrics["inputs"] = {{"gt", a.gt},
+                       {"est", a.est},
+                       {"format", a.format},
+                       {"covariates", a.covariates},
+                       {"attitude_reference", a.attitude_reference}};
   metrics["algorithms"][e.algorithm] = eval::to_json(e, in.options);
   // The single algorithm's metrics also at the top level, for quick access.
   for (auto& [key, value] : metrics["algorithms"][e.algorithm].items()) metrics[key] = value;
@@ -313,6 +319,9 @@ struct EvalVerb : Pinned {
                     "(x right, y down, z forward), as X,Y,Z [m]; the estimate stays the camera's "
                     "(eval.reference_point_m)")
         ->capture_default_str();
+    cmd->add_option("--attitude-reference", ev.attitude_reference,
+                    "An AHRS's angles (a run's ahrs.csv: t_ns, roll_deg, pitch_deg, yaw_deg): "
+                    "Table 1's angle rows also as the river paper computed them, Eq. (11)");
     cmd->add_option("--name", ev.name, "Algorithm name in tables (default: estimate file stem)");
     cmd->add_option("--out", ev.out, "Output folder (written atomically)")->required();
     cmd->add_flag("--force", ev.force, "Replace an existing output folder");

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
+
 #include "core/error.hpp"
 
 namespace driftlab::eval {
@@ -30,6 +32,35 @@ std::size_t nearest(const std::vector<TimeNs>& times, TimeNs t, TimeNs tolerance
 }
 
 }  // namespace
+
+AttitudeReference read_attitude_reference(const std::string& path) {
+  const FrameTable table = read_frame_table(path);
+  const char* names[3] = {"roll_deg", "pitch_deg", "yaw_deg"};
+  const std::vector<double>* cols[3];
+  for (int i = 0; i < 3; ++i) {
+    cols[i] = table.column(names[i]);
+    if (cols[i] == nullptr)
+      throw UserError(
+          fmt::format("{}: no column '{}', expected roll_deg, pitch_deg and yaw_deg "
+                      "(an AHRS's angles, as a run's ahrs.csv)",
+                      path, names[i]));
+  }
+  AttitudeReference out;
+  out.t_ns = table.t_ns;
+  for (std::size_t r = 0; r < table.t_ns.size(); ++r) {
+    double v[3];
+    for (int i = 0; i < 3; ++i) {
+      v[i] = (*cols[i])[r];
+      if (!std::isfinite(v[i]))
+        throw UserError(
+            fmt::format("{}: data row {} (t_ns {}): {} is missing or not finite, "
+                        "expected an angle in degrees",
+                        path, r + 1, table.t_ns[r], names[i]));
+    }
+    out.euler.push_back({deg2rad(v[0]), deg2rad(v[1]), deg2rad(v[2])});
+  }
+  return out;
+}
 
 PaperAttitude paper_attitude(const std::vector<TimeNs>& t_ns, const std::vector<SE3>& T_W_C_est,
                              const std::vector<Section>& sections,

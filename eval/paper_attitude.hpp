@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "core/rotation.hpp"
@@ -26,6 +27,11 @@ struct AttitudeReference {
   std::vector<TimeNs> t_ns;  // strictly increasing
   std::vector<EulerZYX> euler;
 };
+
+/// An AHRS's angles from a CSV with a header (read_frame_table()): a time column and columns
+/// roll_deg, pitch_deg and yaw_deg (a run's ahrs.csv). Throws UserError naming the file and the
+/// missing column, or the row and column of a missing or non-finite angle.
+AttitudeReference read_attitude_reference(const std::string& path);
 
 struct PaperAttitude {
   Summary roll_deg_per_m, pitch_deg_per_m, yaw_deg_per_m;  // over the sections with both ends

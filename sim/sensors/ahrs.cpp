@@ -84,7 +84,7 @@ std::optional<AhrsSample> AhrsSimulator::update(const BodySample& b) {
 }
 
 AhrsCsvWriter::AhrsCsvWriter(const std::filesystem::path& path)
-    : rows_(path, "#timestamp [ns],roll [deg],pitch [deg],yaw [deg]\n", "AHRS") {}
+    : rows_(path, "t_ns,roll_deg,pitch_deg,yaw_deg\n", "AHRS") {}
 
 void AhrsCsvWriter::write(const AhrsSample& s) {
   const EulerZYX& e = s.euler;

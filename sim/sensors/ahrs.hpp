@@ -68,9 +68,10 @@ class AhrsSimulator {
   long updates_ = 0;
 };
 
-/// ahrs.csv, one row per reported sample:
-///   #timestamp [ns],roll [deg],pitch [deg],yaw [deg]
-/// ZYX Euler angles of the AHRS frame in world NED (yaw magnetic, in (-180, 180]).
+/// ahrs.csv, one row per reported sample (the columns of a frame table, as frames.csv, so that
+/// `driftlab eval --attitude-reference` reads it):
+///   t_ns,roll_deg,pitch_deg,yaw_deg
+/// ZYX Euler angles of the AHRS frame in magnetic NED (yaw in (-180, 180]).
 /// Nothing appears at PATH unless commit() is called.
 class AhrsCsvWriter {
  public:

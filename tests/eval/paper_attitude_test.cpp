@@ -7,9 +7,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <string>
 #include <vector>
 
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
 #include "core/rotation.hpp"
+#include "eval/evaluate.hpp"
 #include "eval/paper_attitude.hpp"
 #include "eval/sections.hpp"
 #include "tests/support/test_support.hpp"
@@ -99,6 +104,54 @@ TEST(PaperAttitude, FramesWithoutAReferenceSampleNearAreLeftOut) {
   t.hull.euler.resize(5);
   const PaperAttitude a = paper_attitude(t.t_ns, t.T_W_C, {}, t.hull, 1'000'000);
   EXPECT_EQ(a.pairs, 5u);
+}
+
+TEST(PaperAttitude, ReadsAnAhrsCsvAndNamesWhatIsWrong) {
+  const auto dir = std::filesystem::temp_directory_path();
+  const auto good = dir / "driftlab_ahrs_good.csv";
+  write_file_atomic(good, "t_ns,roll_deg,pitch_deg,yaw_deg\n0,1.5,-2,90\n7812500,0,0,-180\n");
+  const AttitudeReference r = read_attitude_reference(good.string());
+  ASSERT_EQ(r.t_ns.size(), 2u);
+  EXPECT_EQ(r.t_ns[1], 7812500);
+  EXPECT_NEAR(r.euler[0].roll_rad, 1.5 * kDeg, 1e-15);
+  EXPECT_NEAR(r.euler[0].pitch_rad, -2 * kDeg, 1e-15);
+  EXPECT_NEAR(r.euler[0].yaw_rad, 90 * kDeg, 1e-15);
+  auto error_of = [&](const std::string& text) {
+    const auto bad = dir / "driftlab_ahrs_bad.csv";
+    write_file_atomic(bad, text);
+    try {
+      read_attitude_reference(bad.string());
+    } catch (const UserError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error_of("t_ns,roll_deg,yaw_deg\n0,1,2\n").find("no column 'pitch_deg'"),
+            std::string::npos);
+  EXPECT_NE(error_of("t_ns,roll_deg,pitch_deg,yaw_deg\n0,1,2,3\n5,1,nan,3\n")
+                .find("data row 2 (t_ns 5): pitch_deg is missing"),
+            std::string::npos);
+  EXPECT_NE(error_of("t_ns,roll_deg,pitch_deg,yaw_deg\n0,1,2,x\n").find("yaw_deg: got 'x'"),
+            std::string::npos);
+  std::filesystem::remove(good);
+}
+
+TEST(PaperAttitude, TheEvaluationCarriesItIntoMetricsWhenGivenAReference) {
+  const Turn t = turn(9 * kDeg, 180 * kDeg, 180);
+  EvaluationInput in;
+  for (std::size_t k = 0; k < t.t_ns.size(); ++k) {
+    in.gt.push_back({t.t_ns[k], t.T_W_C[k]});
+    in.est.push_back({t.t_ns[k], t.T_W_C[k]});
+  }
+  in.options.align = Alignment::kNone;
+  EXPECT_FALSE(evaluate(in).paper_attitude.has_value());
+  in.attitude_reference = t.hull;
+  const Evaluation e = evaluate(in);
+  ASSERT_TRUE(e.paper_attitude.has_value());
+  const nlohmann::json j = to_json(e, in.options);
+  EXPECT_NEAR(j["paper_attitude"]["max_abs_deg"]["pitch"].get<double>(), 18.0, 1e-6);
+  EXPECT_EQ(j["paper_attitude"]["pairs"].get<std::size_t>(), t.t_ns.size());
+  EXPECT_NE(tables_markdown(e, in.options).find("AHRS − VO"), std::string::npos);
 }
 
 }  // namespace

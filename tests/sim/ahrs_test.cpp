@@ -131,7 +131,7 @@ TEST(Ahrs, CsvHasTheHeaderAndOneRowPerSampleInDegrees) {
   std::filesystem::remove(path);
   // The first row's angles, back in radians, are the sample's.
   const std::size_t row = text.find('\n') + 1;
-  EXPECT_EQ(text.substr(0, row - 1), "#timestamp [ns],roll [deg],pitch [deg],yaw [deg]");
+  EXPECT_EQ(text.substr(0, row - 1), "t_ns,roll_deg,pitch_deg,yaw_deg");
   double t = 0, roll = 0, pitch = 0, yaw = 0;
   ASSERT_EQ(std::sscanf(text.c_str() + row, "%lf,%lf,%lf,%lf", &t, &roll, &pitch, &yaw), 4);
   EXPECT_EQ(t, 1000);
