@@ -703,7 +703,9 @@ struct AhrsOptions {
   // The x-IMU's IMU-3000 gyroscope and LSM303DLH accelerometer: their noise is taken from the
   // mpu9250 preset (InvenSense's later part); the datasheets' figures were not confirmed.
   ImuPreset imu_preset = ImuPreset::kMpu9250;
-  // LSM303DLH magnetometer at +-1.3 gauss: 1055 LSB/gauss (about 95 nT a count); two counts.
+  // The LSM303DLH's magnetometer at +-1.3 gauss: about two counts. A count is 91 nT on its
+  // successor, the LSM303DLHC (1100 LSB/gauss, datasheet Table 75); the DLH's own gain was not
+  // confirmed.
   double magnetometer_noise_nt = 190.0;
   MountOptions mount;
 
