@@ -246,12 +246,18 @@ TEST(ImuErrors, EachNoiseSourceHasItsOwnStream) {
 
 // --- Compass ------------------------------------------------------------------
 
-TEST(CompassSensor, CleanCompassReportsTrueHeadingAtAnyTilt) {
+// A compass without noise, at the given declination and a dip of 66 deg.
+CompassOptions noise_free_compass(double declination_deg) {
   CompassOptions o;
   o.sigma_deg = 0;
   o.field_noise_nt = 0;
-  o.declination_deg = 7.5;
+  o.declination_deg = declination_deg;
   o.inclination_deg = 66;
+  return o;
+}
+
+TEST(CompassSensor, CleanCompassReportsTrueHeadingAtAnyTilt) {
+  CompassOptions o = noise_free_compass(7.5);
   o.mount.rpy_deg = {0, 0, 0};
   CompassSimulator compass(o, RngStreams(1));
   Rng rng(3);
@@ -279,11 +285,7 @@ TEST(CompassSensor, AStrapdownCompassLevelsWithTheApparentGravity) {
   // heading: atan2(H, Z sin(theta)) instead of 90 deg (written out by hand). Levelled with
   // the true attitude, or at rest, the heading is exact; a compass that does not level at all
   // reads the same on a level hull.
-  CompassOptions o;
-  o.sigma_deg = 0;
-  o.field_noise_nt = 0;
-  o.declination_deg = 0;
-  o.inclination_deg = 66;
+  CompassOptions o = noise_free_compass(0);
   BodySample b = pose(0, 0, 90 * kDeg, Vec3::Zero());
   const double a = 0.3;
   b.v_dot_B = Vec3(a, 0, 0);
