@@ -204,6 +204,8 @@ struct StereoRenderer::Impl {
   GLsizei water_count = 0;
   int water_segments = 0;
   float water_radius_m = 0;
+  // The grid's spacing over its radius, radial (ring to ring) and tangential (u_grid_step).
+  Eigen::Vector2f water_grid_step = Eigen::Vector2f::Zero();
   float wave_amplitude_sum_m = 0;
   float wave_slope_sum = 0;   // sum of amplitude x wavenumber: a bound on the waves' slope
   std::vector<float> wave_a;  // 4 per component
@@ -314,7 +316,8 @@ StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& option
       for (int ripples : {0, 1})
         impl_->water_progs[mode][sun][ripples] =
             link_program(shaders::kWaterVs, shaders::kWaterFs, "water",
-                         defines + fmt::format("#define RIPPLES {}\n", ripples));
+                         defines + fmt::format("#define RIPPLES {}\n", ripples) +
+                             shaders::kWaterWaves);
     }
   for (int sun : {0, 1})
     for (int clouds : {0, 1})
@@ -370,6 +373,8 @@ void StereoRenderer::Impl::build_water_grid() {
   }
   water_segments = segments;
   water_radius_m = r1;
+  water_grid_step = {std::pow(r1 / r0, 1.f / (rings - 1)) - 1.f,
+                     2.f * std::numbers::pi_v<float> / segments};
   glGenVertexArrays(1, &water_vao);
   glBindVertexArray(water_vao);
   glGenBuffers(1, &water_vbo);
@@ -789,6 +794,7 @@ void StereoRenderer::Impl::draw_water(const Eigen::Matrix4f& view, const Eigen::
   // Time modulo a long period keeps float phases accurate.
   glUniform1f(loc(water_prog, "u_time"), static_cast<float>(t));
   glUniform2f(loc(water_prog, "u_centre"), eye.x(), eye.y());
+  glUniform2f(loc(water_prog, "u_grid_step"), water_grid_step.x(), water_grid_step.y());
   glUniform3f(loc(water_prog, "u_eye"), eye.x(), eye.y(), eye.z());
   glUniform1i(loc(water_prog, "u_has_reflection"), reflection != 0 ? 1 : 0);
   glUniform2f(loc(water_prog, "u_viewport"), static_cast<float>(rig.camera.width),
@@ -914,9 +920,9 @@ std::pair<int, int> StereoRenderer::Impl::reflection_rows(int row_begin, int row
   // (kWaterFs): no simple bound, so the whole image.
   if (ripples || (row_begin == 0 && row_end == H)) return {0, RH};
   // Without them the water shader reads the texture bilinearly at uv = pixel centre /
-  // viewport + 0.15 n.xy, n the interpolated upward normal of the waves, clamped to
-  // reflection_shift_max: |n.xy| <= min(1, |grad eta|) <= min(1, sum of amplitude x
-  // wavenumber) wherever n is interpolated inside its triangle.
+  // viewport + 0.15 n.xy, n the upward normal of the waves at the pixel (kWaterWaves),
+  // clamped to reflection_shift_max: |n.xy| <= min(1, |grad eta|) <= min(1, sum of
+  // amplitude x wavenumber), the low-pass only lowering each component's slope.
   const double shift = reflection_shift_max();
   const double v_lo = (row_begin + 0.5) / H - shift, v_hi = (row_end - 0.5) / H + shift;
   // Texel rows: the bilinear pair about v RH - 0.5, and two more on each side for rounding.

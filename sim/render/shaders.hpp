@@ -222,33 +222,55 @@ void main() {
 }
 )";
 
-// The water: a polar grid around the camera displaced by the wave components
-// (eta positive up, surface at z = -eta), normals from the analytic slope at
-// the vertices (as fine as the displaced geometry itself).
-inline constexpr const char* kWaterVs = R"(
-layout(location = 0) in vec2 a_grid;       // offset from the camera, world x/y
+// The wave components (sim/waves/wave_field.hpp), shared by the water's two stages: the
+// vertex stage displaces the grid with them, the fragment stage takes its normal from them.
+inline constexpr const char* kWaterWaves = R"(
 const int N = 32;
 uniform vec4 u_wave_a[N];   // amplitude, kx, ky, omega
 uniform float u_wave_phase[N];
 uniform int u_wave_count;
 uniform float u_time;
+// The waves' height eta (z) and slope grad eta (xy) at xy, as a sampler with steps d1 and d2
+// [m] can carry them (the grid's spacing at a vertex, a pixel's footprint on the water): the
+// field low-passed by a Gaussian of standard deviation |d| / 2 along each step, so a
+// component of wavevector k keeps exp(-((k.d1)^2 + (k.d2)^2) / 8) of its amplitude (0.29 at
+// the Nyquist wavelength, k.d = pi; 0.007 at the step itself) instead of aliasing.
+// `unresolved`: the slope variance so left out, sum of (1 - g^2) a^2 |k|^2 / 2.
+vec3 waves(vec2 xy, vec2 d1, vec2 d2, out float unresolved) {
+  vec3 s = vec3(0.0);
+  unresolved = 0.0;
+  for (int i = 0; i < u_wave_count; ++i) {
+    vec2 k = u_wave_a[i].yz;
+    float q1 = dot(k, d1), q2 = dot(k, d2);
+    float g = exp(-0.125 * (q1 * q1 + q2 * q2));
+    float a = u_wave_a[i].x;
+    float th = dot(k, xy) - u_wave_a[i].w * u_time + u_wave_phase[i];
+    s.z += g * a * cos(th);
+    s.xy -= g * a * sin(th) * k;
+    unresolved += (1.0 - g * g) * 0.5 * a * a * dot(k, k);
+  }
+  return s;
+}
+)";
+
+// The water: a polar grid around the camera displaced by the wave components it can carry
+// (eta positive up, surface at z = -eta; kWaterWaves). Normals, and with them the Fresnel
+// reflectance, the reflection's offset and the sun's glint, are the fragment stage's, from
+// the waves at each pixel: what the camera sees of the water comes from the waves, not from
+// the mesh.
+inline constexpr const char* kWaterVs = R"(
+layout(location = 0) in vec2 a_grid;       // offset from the camera, world x/y
+uniform vec2 u_grid_step;   // the grid's spacing over its radius: radial, tangential
 uniform vec2 u_centre;
 uniform mat4 u_view;
 uniform mat4 u_proj;
 uniform vec3 u_eye;
 uniform float u_fog;
-uniform float u_reflectivity;
-uniform float u_turbidity;
 #if DEPTH
 out float v_view_z;
 #else
-out vec4 v_shade;          // normal x, y (reflection offset); Fresnel; fog
-#endif
-#if (SUN || RIPPLES) && !DEPTH
+out float v_fog;
 out vec3 v_world;
-#endif
-#if SUN && !DEPTH
-out vec3 v_normal;
 #endif
 #if RIPPLES && !DEPTH
 uniform vec2 u_focal;       // fx, fy [px]
@@ -262,35 +284,22 @@ vec2 mirror_px(vec3 d, vec2 s) {
 #endif
 void main() {
   vec2 xy = u_centre + a_grid;
-  float eta = 0.0;
-  vec2 slope = vec2(0.0);
-  for (int i = 0; i < u_wave_count; ++i) {
-    float th = u_wave_a[i].y * xy.x + u_wave_a[i].z * xy.y - u_wave_a[i].w * u_time + u_wave_phase[i];
-    eta += u_wave_a[i].x * cos(th);
-    slope -= u_wave_a[i].x * sin(th) * u_wave_a[i].yz;
-  }
+  float r = length(a_grid);
+  vec2 radial = r > 0.0 ? a_grid / r : vec2(1.0, 0.0);
+  float unresolved;
+  float eta = waves(xy, radial * (r * u_grid_step.x), vec2(-radial.y, radial.x) * (r * u_grid_step.y),
+                    unresolved).z;
   vec3 p = vec3(xy, -eta);
   vec4 c = u_view * vec4(p, 1.0);
 #if DEPTH
   v_view_z = c.z;
 #else
-  vec3 n = normalize(vec3(-slope, -1.0));   // upward normal (z is down)
-  vec3 v = normalize(u_eye - p);
-  float cos_t = clamp(dot(n, v), 0.0, 1.0);
-  // Schlick's approximation of the Fresnel reflectance of water (n = 1.33).
-  float m = 1.0 - cos_t, m2 = m * m;
-  float fresnel = (0.02 + 0.98 * m2 * m2 * m) * u_reflectivity * (1.0 - 0.5 * u_turbidity);
-  v_shade = vec4(n.xy, fresnel, exp(-length(u_eye - p) / u_fog));
-#if SUN || RIPPLES
+  v_fog = exp(-length(u_eye - p) / u_fog);
   v_world = p;
-#endif
-#if SUN
-  v_normal = n;
-#endif
 #if RIPPLES
   // The Jacobian of the mirror pixel in the ripple slope at the flat surface:
   // smooth over the water, so taken once per vertex (central differences).
-  vec3 d = -v;
+  vec3 d = normalize(p - u_eye);
   const float eps = 0.01;
   v_jacobian = vec4(mirror_px(d, vec2(eps, 0.0)) - mirror_px(d, vec2(-eps, 0.0)),
                     mirror_px(d, vec2(0.0, eps)) - mirror_px(d, vec2(0.0, -eps))) / (2.0 * eps);
@@ -304,13 +313,8 @@ inline constexpr const char* kWaterFs = R"(
 #if DEPTH
 in float v_view_z;
 #else
-in vec4 v_shade;
-#endif
-#if (SUN || RIPPLES) && !DEPTH
+in float v_fog;
 in vec3 v_world;
-#endif
-#if SUN && !DEPTH
-in vec3 v_normal;
 #endif
 #if RIPPLES && !DEPTH
 in vec4 v_jacobian;
@@ -335,6 +339,7 @@ uniform vec2 u_viewport;
 uniform float u_shift_max;      // bound on the waves' tilt of the lookup [uv]
 uniform float u_body;
 uniform float u_turbidity;
+uniform float u_reflectivity;
 uniform float u_sky;
 uniform vec3 u_sun_dir;
 out vec4 frag;
@@ -351,13 +356,21 @@ void main() {
 #if DEPTH
   frag = vec4(v_view_z, 0.0, 0.0, 1.0);
 #else
+  // The waves at this pixel, low-passed by its footprint on the water.
+  float waves_unresolved;
+  vec2 slope_w = waves(v_world.xy, dFdx(v_world.xy), dFdy(v_world.xy), waves_unresolved).xy;
+  vec3 n = normalize(vec3(-slope_w, -1.0));   // upward normal (z is down)
+  vec3 v = normalize(u_eye - v_world);
+  float cos_t = clamp(dot(n, v), 0.0, 1.0);
+  // Schlick's approximation of the Fresnel reflectance of water (n = 1.33).
+  float m = 1.0 - cos_t, m2 = m * m;
+  float fresnel = (0.02 + 0.98 * m2 * m2 * m) * u_reflectivity * (1.0 - 0.5 * u_turbidity);
   float refl = u_sky;
   if (u_has_reflection) {
-    // The waves' normal tilts the lookup by at most u_shift_max (their slope bound), which
-    // only an attribute extrapolated outside its triangle under MSAA would pass: the band of
-    // the mirror image a rolling-shutter band draws holds every row it reads.
+    // The waves' normal tilts the lookup by at most u_shift_max (their slope bound): the band
+    // of the mirror image a rolling-shutter band draws holds every row it reads.
     vec2 uv = gl_FragCoord.xy / u_viewport
-            + clamp(0.15 * v_shade.xy, -u_shift_max, u_shift_max) * vec2(1.0, -1.0);
+            + clamp(0.15 * n.xy, -u_shift_max, u_shift_max) * vec2(1.0, -1.0);
 #if RIPPLES
     // Wind ripples: the mip-mapped moments averaged over this pixel's
     // footprint. Their mean slope tilts the reflected ray; their variance
@@ -369,7 +382,7 @@ void main() {
     vec4 m1 = texture(u_ripple_map1, rel * u_ripple_inv_size1 + u_ripple_offset1);
     vec2 slope = m0.xy + m1.xy;
     float unresolved = max(m0.z + m0.w - dot(m0.xy, m0.xy), 0.0)
-                     + max(m1.z + m1.w - dot(m1.xy, m1.xy), 0.0);
+                     + max(m1.z + m1.w - dot(m1.xy, m1.xy), 0.0) + waves_unresolved;
     // Where the reflected ray through the rippled surface lands in the
     // mirror image, against the ray through the flat surface: exact for
     // the reflection of distant objects.
@@ -404,16 +417,15 @@ void main() {
 #endif
   }
   float body = u_body * (0.6 + 0.8 * u_turbidity);
-  float g = mix(body, refl, v_shade.z);
+  float g = mix(body, refl, fresnel);
 #if SUN
-  vec3 n = normalize(v_normal);
-  vec3 r = reflect(-normalize(u_eye - v_world), n);
+  vec3 r = reflect(-v, n);
   g += 0.8 * pow(max(dot(r, u_sun_dir), 0.0), 300.0);
 #endif
 #if COLOUR
-  frag = vec4(vec3(mix(u_sky, g, v_shade.w)), 1.0);
+  frag = vec4(vec3(mix(u_sky, g, v_fog)), 1.0);
 #else
-  frag = vec4(mix(u_sky, g, v_shade.w), 0.0, 0.0, 1.0);
+  frag = vec4(mix(u_sky, g, v_fog), 0.0, 0.0, 1.0);
 #endif
 #endif
 }

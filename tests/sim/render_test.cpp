@@ -10,6 +10,7 @@
 #include <memory>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/rng.hpp"
@@ -211,6 +212,78 @@ TYPED_TEST(RenderTest, RepeatedRendersAreByteIdentical) {
   for (int x = 0; x < 640; ++x) lower_nonzero += a.left.at(x, 470) > 0;
   EXPECT_GT(lower_nonzero, 600);
   this->renderer_->set_waves({});
+}
+
+// Water alone under a uniform bright sky, seen from 0.5 m up by a camera pitched 5 deg down:
+// its grey is the Fresnel reflectance of the sky, so where the water is rippled it is brighter
+// than the calm water's where the surface faces away from the camera. One wave travelling
+// north, of slope amplitude 0.1, frozen (omega 0).
+struct WaterColumn {
+  std::vector<double> grey;       // the centre column's rows [kFirstRow, 480), less the calm grey
+  std::vector<double> predicted;  // the same from Schlick's Fresnel reflectance at the slope
+};
+
+// Schlick's approximation of water's Fresnel reflectance (n = 1.33) of a surface of slope s
+// (grad eta, z down) seen from direction `to_eye`.
+double schlick(const Vec2& s, const Vec3& to_eye) {
+  const double m = 1 - std::clamp(Vec3(-s.x(), -s.y(), -1).normalized().dot(to_eye), 0.0, 1.0);
+  return 0.02 + 0.98 * std::pow(m, 5);
+}
+constexpr int kFirstRow = 350;
+constexpr double kWaterHeightM = 0.5, kWaterPitchRad = -5 * std::numbers::pi / 180;
+
+WaterColumn water_column(StereoRenderer& renderer, double wavelength_m) {
+  SceneGeometry s = dark_scene();
+  s.water.enabled = true;
+  s.water.body_gray = 0;
+  s.water.turbidity = 0;
+  s.lighting.sky_brightness = 1;
+  renderer.upload(s);
+  const Mat3 R_W_B = quat_from_euler_zyx({0, kWaterPitchRad, 0}).toRotationMatrix();
+  const SE3 T_W_C(R_W_B * R_frd_optical(), Vec3(0, 0, -kWaterHeightM));
+  renderer.set_waves({});
+  const StereoImages calm = renderer.render(T_W_C, 0.0, false);
+  const double k = 2 * std::numbers::pi / wavelength_m;
+  renderer.set_waves({WaveComponent{0.1 / k, k, 0.0, 0.0, 0.3}});
+  const StereoImages wavy = renderer.render(T_W_C, 0.0, false);
+  renderer.set_waves({});
+  WaterColumn c;
+  for (int v = kFirstRow; v < 480; ++v) {
+    const Vec3 ray = T_W_C.rotation() * Vec3(0, (v - 239.5) / 500.0, 1);
+    const double x = ray.x() * kWaterHeightM / ray.z();
+    const Vec3 to_eye = -ray.normalized();
+    c.grey.push_back(wavy.left.at(320, v) - calm.left.at(320, v));
+    const Vec2 slope(-0.1 * std::sin(k * x + 0.3), 0);
+    c.predicted.push_back(255 * (schlick(slope, to_eye) - schlick(Vec2::Zero(), to_eye)));
+  }
+  return c;
+}
+
+double grey_sd(const std::vector<double>& x) {
+  double m = 0, q = 0;
+  for (double v : x) m += v / x.size();
+  for (double v : x) q += (v - m) * (v - m) / x.size();
+  return std::sqrt(q);
+}
+
+TYPED_TEST(RenderTest, WaterShowsTheWavesPixelByPixelAndFiltersWhatAPixelCannotHold) {
+  // A 0.15 m wave is longer than a pixel's footprint on these rows (4-11 mm) and shorter than
+  // two steps of the water's mesh there (8-15 cm): the water's grey must follow the slope of
+  // the wave itself where each row's ray meets the water, the brighter the more the surface
+  // faces away from the camera: Schlick's reflectance at the wave's slope, to the rounding.
+  const WaterColumn resolved = water_column(*this->renderer_, 0.15);
+  double worst = 0;
+  for (std::size_t i = 0; i < resolved.grey.size(); ++i)
+    worst = std::max(worst, std::abs(resolved.grey[i] - resolved.predicted[i]));
+  EXPECT_LT(worst, 2.5);  // two 8-bit roundings
+  // A 3 mm wave of the same slope is below the footprint (k d = 8-23 rad a row): the Gaussian
+  // of sd d / 2 keeps exp(-(k d)^2 / 8) < 0.0003 of it, so the water is as calm, where a
+  // surface sampled by its mesh would alias it into a pattern as strong as the resolved one.
+  const WaterColumn unresolved = water_column(*this->renderer_, 0.003);
+  EXPECT_GT(grey_sd(resolved.grey), 5.0);
+  EXPECT_LT(grey_sd(unresolved.grey), 0.05 * grey_sd(resolved.grey));
+  std::cout << "water: worst " << worst << " DN from Schlick, grey sd resolved "
+            << grey_sd(resolved.grey) << ", unresolved " << grey_sd(unresolved.grey) << "\n";
 }
 
 TYPED_TEST(RenderTest, WindRipplesBreakTheMirrorImageOnlyOnTheWater) {
