@@ -314,10 +314,9 @@ StereoRenderer::StereoRenderer(const StereoRig& rig, const RenderOptions& option
               shaders::kSceneVs, shaders::kSceneFs, "scene",
               defines + fmt::format("#define CUTOUT {}\n#define SWAY {}\n", cutout, sway));
       for (int ripples : {0, 1})
-        impl_->water_progs[mode][sun][ripples] =
-            link_program(shaders::kWaterVs, shaders::kWaterFs, "water",
-                         defines + fmt::format("#define RIPPLES {}\n", ripples) +
-                             shaders::kWaterWaves);
+        impl_->water_progs[mode][sun][ripples] = link_program(
+            shaders::kWaterVs, shaders::kWaterFs, "water",
+            defines + fmt::format("#define RIPPLES {}\n", ripples) + shaders::kWaterWaves);
     }
   for (int sun : {0, 1})
     for (int clouds : {0, 1})
