@@ -18,7 +18,7 @@
 //   BM_DenseVo1024/threads:N/sgbm:M
 //                        BM_DenseVo through the river scenarios' Bumblebee2 (1024x768) with N
 //                        threads in OpenCV's pool, M = 1: sgbm_mode sgbm (the default before
-//                        3way, 2026-12-02); one_core_ms adds the
+//                        3way); one_core_ms adds the
 //                        stages (the wall overlaps two of them: with N = 1 it is the work of a
 //                        frame on one core)
 //   BM_Sgbm              cv::StereoSGBM alone on the full pair (the paper's method)

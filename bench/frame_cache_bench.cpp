@@ -1,7 +1,7 @@
-// The frame cache's storage (issue 43): what a stereo pair of the paper's camera (Bumblebee2,
-// 1024x768, river survey with reflections, breeze and sensor noise) costs to keep and to read
-// back, per image, in the cache's form (PNG, deflate level 1, OpenCV) against zstd (levels 1
-// and 3, libzstd) and raw bytes. Counters: bytes per image; the time is per image.
+// The frame cache's storage (docs/design.md, "Frame cache"): what a stereo pair of the paper's
+// camera (Bumblebee2, 1024x768, river survey with reflections, breeze and sensor noise) costs to
+// keep and to read back, per image, in the cache's form (PNG, deflate level 1, OpenCV) against zstd
+// (levels 1 and 3, libzstd) and raw bytes. Counters: bytes per image; the time is per image.
 //   build/bench/frame_cache_bench
 #include <benchmark/benchmark.h>
 #include <xxhash.h>
@@ -96,7 +96,7 @@ void BM_ZstdDecode(benchmark::State& state) {
 BENCHMARK(BM_ZstdDecode)->Arg(1)->Arg(3)->Unit(benchmark::kMillisecond);
 
 // The checksum of a cached image file, which the cache computes twice for every file it
-// serves: 0 FNV-1a 64 (until 2026-12-03), 1 XXH3-64 (since).
+// serves: 0 FNV-1a 64 (what it used before), 1 XXH3-64 (what it uses).
 void BM_FileChecksum(benchmark::State& state) {
   std::vector<std::vector<char>> encoded;
   for (const auto& m : frames()) encoded.push_back(zstd(m, 1));

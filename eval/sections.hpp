@@ -55,7 +55,7 @@ std::string run_vo_of(const std::vector<std::string>& vos, const std::string& al
 /// motion (`NAME_valid` 0), `NAME_lost` as `lost`, and the scene's `moving_px` (the share of
 /// the image showing moving things, a covariate of every VO). The run's other columns (render and
 /// camera timings, the other VOs) are left out, as in the run's evaluation. For a frames.csv
-/// written before `NAME_features` existed (2026-11-27), f is `NAME_valid_depth_px` where that
+/// written before `NAME_features` existed, f is `NAME_valid_depth_px` where that
 /// is positive (the dense VO), else `NAME_inliers`. Throws UserError naming `path` and the VOs
 /// present when `vo` is not one of them.
 FrameTable run_vo_covariates(const FrameTable& run_frames, const std::string& vo,

@@ -16,13 +16,14 @@
 // tolerance is a regression), higher, or both (any change beyond it is).
 // The tolerance is max(abs_tol, rel_tol * |baseline|); both default to 0.
 //
-// Paired metrics (issue 43): where the results hold a metric per job or per section of a job
-// (a merged sweep's algorithms.NAME.pairs.METRIC, an object {"p0000-r00/3": value, ...}), the
-// entry keeps every pair's value ("pairs": [{"id": ..., "value": ...}]) and the gate compares
-// the new values with them pair by pair (gate/paired.hpp): a regression is a change in the bad
-// direction that a one-sided Wilcoxon signed-rank test finds at level `alpha` AND that moves
-// the mean by more than `min_effect` of the baseline's. A pair the new results lack is a
-// failure (MISSING): a VO that loses sections must not pass by losing its worst ones.
+// Paired metrics (docs/sweeps.md, "Paired comparisons"): where the results hold a metric per job or
+// per section of a job (a merged sweep's algorithms.NAME.pairs.METRIC, an object
+// {"p0000-r00/3": value, ...}), the entry keeps every pair's value
+// ("pairs": [{"id": ..., "value": ...}]) and the gate compares the new values with them pair by
+// pair (gate/paired.hpp): a regression is a change in the bad direction that a one-sided Wilcoxon
+// signed-rank test finds at level `alpha` AND that moves the mean by more than `min_effect` of the
+// baseline's. A pair the new results lack is a failure (MISSING): a VO that loses sections must
+// not pass by losing its worst ones.
 #pragma once
 
 #include <array>

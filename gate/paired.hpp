@@ -1,7 +1,7 @@
-// Paired comparisons (issue 43): runs are deterministic, so a baseline and a change can be
-// compared pair by pair (the same job, or the same section of the same job) instead of mean
-// against mean. Used by the gate (`driftlab regress`, a metric with pairs) and by `driftlab
-// sweep merge` (VOs side by side on the same seeds).
+// Paired comparisons (docs/sweeps.md, "Paired comparisons"): runs are deterministic, so a baseline
+// and a change can be compared pair by pair (the same job, or the same section of the same job)
+// instead of mean against mean. Used by the gate (`driftlab regress`, a metric with pairs) and by
+// `driftlab sweep merge` (VOs side by side on the same seeds).
 //
 // For pairs (a_i, b_i) and differences d_i = b_i - a_i:
 //   - the mean difference with its 95 % confidence interval (Student's t, n - 1 degrees of

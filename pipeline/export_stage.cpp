@@ -21,7 +21,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The left image's mask of moving things, numbered as the export's frames (issue 46, item 5).
+// The left image's mask of moving things (mask_0/ in docs/datasets.md), numbered as the export's
+// frames.
 void write_mask(const fs::path& path, const sim::GrayImage& mask) {
   if (!cv::imwrite(path.string(), cv_view(mask)))
     throw UserError(fmt::format("{}: cannot write the mask", path.string()));

@@ -1,5 +1,5 @@
-// The frame cache's store (issue 43): stereo frames kept under a key text that names
-// everything deciding their bytes, so that runs whose frames would come out the same replay
+// The frame cache's store (docs/design.md, "Frame cache"): stereo frames kept under a key text that
+// names everything deciding their bytes, so that runs whose frames would come out the same replay
 // them instead of rendering. An entry is a folder named by the FNV-1a 64 of its key
 // (core/hash.hpp) holding:
 //   key.txt     the key text itself, compared whole on every lookup (so two keys never share

@@ -1,6 +1,6 @@
-// The frame cache's key (issue 43): a text naming everything that decides the bytes of a run's
-// frames, so that two runs share cached frames exactly when their frames would come out the
-// same. It holds
+// The frame cache's key (docs/design.md, "Frame cache"): a text naming everything that decides the
+// bytes of a run's frames, so that two runs share cached frames exactly when their frames would
+// come out the same. It holds
 //   - the renderer's identity: the code (renderer_code_identity(): the SHA-256 of every source
 //     under core/, sim/, scenes/ and the camera-stage files of pipeline/, and of the compiler
 //     and flags, computed at build time by cmake/DriftlabRendererIdentity.cmake), the OpenCV

@@ -46,7 +46,8 @@ constexpr auto enum_table(FusionAlgorithm) {
 /// braces around anything but one word ("{ print $1 }") are the shell's.
 std::string unknown_command_placeholder(const std::string& command);
 
-/// A VO of the user's, run as a command on an export of the run's own frames (issue 17).
+/// A VO of the user's, run as a command on an export of the run's own frames (docs/datasets.md,
+/// "External VOs in runs and sweeps").
 struct ExternalVoOptions {
   std::string name;
   std::string command;

@@ -1,4 +1,4 @@
-// The VO tracks of a run, each along its own sequence of frames (issue 44): a VO takes frame k
+// The VO tracks of a run, each along its own sequence of frames: a VO takes frame k
 // as soon as it has finished frame k-1 and frame k is in, whatever frame the other VOs are at,
 // so that the slowest VO no longer holds the others at every frame (process_vos' barrier: on
 // two cores the dense VO beside the two sparse ones left a core idle for about 8 ms a frame).

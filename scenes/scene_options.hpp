@@ -34,9 +34,10 @@ constexpr auto enum_table(Sky) {
   return std::array{std::pair{Sky::kOvercast, "overcast"}, std::pair{Sky::kSun, "sun"}};
 }
 
-/// Another vessel on the river (issue 46, item 4): a motor boat under way along the river at a
-/// steady speed, or moored (speed 0), rocking in roll, pitch and heave (sim::MoverMotion). Its
-/// pixels are the moving things of the masks (`driftlab render --masks`, frames.csv moving_px).
+/// Another vessel on the river (docs/renderer-and-scenes.md, "Other vessels: a moving world"): a
+/// motor boat under way along the river at a steady speed, or moored (speed 0), rocking in roll,
+/// pitch and heave (sim::MoverMotion). Its pixels are the moving things of the masks
+/// (`driftlab render --masks`, frames.csv moving_px).
 struct OtherVesselOptions {
   double north_m = 0;
   double east_m = 7;

@@ -1,6 +1,7 @@
-// Other vessels on the river (issue 46, item 4): motor boats under way or moored, each a mover
-// of the scene (sim::MoverMotion): a hull, a deck and a wheelhouse in the vessel's own frame
-// (FRD, origin on the waterline at mid-length), drawn at its pose at every instant.
+// Other vessels on the river (docs/renderer-and-scenes.md, "Other vessels: a moving world"): motor
+// boats under way or moored, each a mover of the scene (sim::MoverMotion): a hull, a deck and a
+// wheelhouse in the vessel's own frame (FRD, origin on the waterline at mid-length), drawn at its
+// pose at every instant.
 #pragma once
 
 #include <cstdint>

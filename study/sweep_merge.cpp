@@ -489,7 +489,7 @@ Part pooled_regression(const Pool& pool, const std::vector<const PooledSection*>
 
 // Every job's value of the gate's paired metrics (gate/gate.hpp), by job id, and every
 // section's position error by JOB/INDEX: what a baseline and a change are compared on pair by
-// pair (issue 43). Non-finite values are left out.
+// pair. Non-finite values are left out.
 nlohmann::ordered_json per_pair_values(const Pool& pool, const std::string& algo,
                                        const std::vector<const PooledSection*>& rows) {
   nlohmann::ordered_json pairs;
@@ -574,9 +574,10 @@ std::map<std::string, double> pair_values(const nlohmann::ordered_json& values,
 const char* kPairedHead =
     "| B vs A | metric | pairs | A | B | B - A | p |\n|---|---|---|---|---|---|---|\n";
 
-// A/B statistics of every two algorithms on the same jobs (issue 43): for each paired metric,
-// the mean of B - A over the pairs both have (sections by JOB/INDEX, run metrics by job) with
-// its 95 % interval and the two-sided Wilcoxon signed-rank p-value (gate/paired.hpp).
+// A/B statistics of every two algorithms on the same jobs (summary.md's "Paired comparisons"): for
+// each paired metric, the mean of B - A over the pairs both have (sections by JOB/INDEX, run
+// metrics by job) with its 95 % interval and the two-sided Wilcoxon signed-rank p-value
+// (gate/paired.hpp).
 Part paired_algorithms(const nlohmann::ordered_json& algorithms) {
   Part p;
   p.json = nlohmann::ordered_json::object();

@@ -1,5 +1,6 @@
 // VOs of a user's own, registered by name in their program, so that scenarios select them as
-// `pipeline.vo: [my_vo]` beside the built-in ones (issue 17, in-process plug-ins):
+// `pipeline.vo: [my_vo]` beside the built-in ones (in-process plug-ins; docs/datasets.md,
+// "Your VO in-process: the installed package"):
 //
 //   driftlab::vo::register_vo("my_vo", [](const driftlab::StereoRig& rig, driftlab::Rng rng) {
 //     return std::make_unique<MyVo>(rig, rng);

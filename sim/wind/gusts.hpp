@@ -1,6 +1,6 @@
-// The wind in the vegetation (issue 46, item 4): the gusts of water.wind, and how the river
-// bank's trees, bushes and reeds sway in them, in closed form so that every instant a renderer
-// draws has its exact pose.
+// The wind in the vegetation (docs/renderer-and-scenes.md, "Wind in the vegetation"): the gusts of
+// water.wind, and how the river bank's trees, bushes and reeds sway in them, in closed form so that
+// every instant a renderer draws has its exact pose.
 //
 // Gusts: the along-wind turbulence u'(t) of a mean wind U has the Kaimal spectrum of IEC
 // 61400-1 (Annex C), S(f) = 4 sigma^2 (L / U) / (1 + 6 f L / U)^(5/3), sigma = I U with the

@@ -58,8 +58,8 @@ struct DenseVoOptions {
   int sgbm_uniqueness_ratio_pct = 10;  // OpenCV: 5..15
   int sgbm_speckle_window_px = 100;    // OpenCV: 50..200
   int sgbm_speckle_range_px = 2;       // OpenCV: 1 or 2
-  // ours: 3way, since 2026-12-02 (sgbm before): faster on one core than sgbm, parallel, and as
-  // accurate (the paper names no SGBM variant; docs/vo-and-filters.md has the modes compared).
+  // ours: 3way: faster on one core than sgbm, parallel, and as accurate (the paper names no SGBM
+  // variant; docs/vo-and-filters.md has the modes compared).
   DenseSgbmMode sgbm_mode = DenseSgbmMode::kThreeWay;
   // ours (extended only): SGBM on the pair shrunk 2x finds the depths to within a pixel at an
   // eighth of the cost; refine_disparity then makes them sub-pixel at full resolution.
