@@ -1,4 +1,4 @@
-// The installed package (issue 17, in-process plug-ins): `cmake --install`, then
+// The installed package (in-process plug-ins): `cmake --install`, then
 // examples/custom_vo built against it with find_package(driftlab), its VO registered by name
 // and run by its own driftlab command line beside the built-in ones.
 #include <gtest/gtest.h>

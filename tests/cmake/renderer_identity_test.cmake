@@ -1,4 +1,4 @@
-# The frame cache's renderer identity (cmake/DriftlabRendererIdentity.cmake, issue 43): the
+# The frame cache's renderer identity (cmake/DriftlabRendererIdentity.cmake): the
 # build hashes every file that decides a frame's bytes, so that a change to a shader, scene or
 # camera effect makes every cached frame a miss. Checked here:
 #   1. the build's list names the renderer, its shaders, the scene builders, the textures and

@@ -146,7 +146,7 @@ TEST(Sections, ARunsFrameTableGivesEachVoItsCovariates) {
   EXPECT_EQ((*s.column("mean_depth_m"))[1], 21.5);
   EXPECT_EQ(*s.column("lost"), (std::vector<double>{0, 0, 1}));
 
-  // Before the `_features` column (2026-11-27): the inliers, or the dense VO's valid-depth
+  // A frames.csv from before the `_features` column: the inliers, or the dense VO's valid-depth
   // pixels; no `lost`.
   const FrameTable kf = run_vo_covariates(run, "sparse_kf", "frames.csv");
   EXPECT_EQ(kf.names, (std::vector<std::string>{"yaw_deg", "inliers", "moving_px"}));

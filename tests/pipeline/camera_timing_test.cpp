@@ -1,4 +1,4 @@
-// Cameras as they are (issue 45, items 1-3): a rolling shutter and an
+// Cameras as they are (docs/sensors.md, "Shutter and stereo timing"): a rolling shutter and an
 // unsynchronised stereo pair, each against its closed form on rendered frames.
 //
 // The scene is a white wall facing the camera over a black sky, so that each

@@ -128,7 +128,7 @@ TEST(FrameSource, ZeroThreadsMeansEveryCore) {
 }
 
 // ---------------------------------------------------------------------------
-// With a frame cache (issue 43)
+// With a frame cache
 
 fs::path fresh_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() /

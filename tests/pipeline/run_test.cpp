@@ -123,7 +123,7 @@ std::string frames_without_timing(const fs::path& dir) {
 TEST(Run, SameBytesWhateverTheThreadCountAndFromTheFrameCache) {
   // Rendering on a thread of its own and the two VOs side by side (threads: 2) or all in turn
   // (threads: 1), with dropped frames and a keyframe VO: the same estimates, tables and
-  // per-frame rows. Issue 43: the same again when the frames are rendered into the frame cache
+  // per-frame rows. The same again when the frames are rendered into the frame cache
   // (b) and replayed from it (c, with another thread count, which the key leaves out).
   const fs::path a = temp_dir("threads1"), b = temp_dir("threads2"), c = temp_dir("cached"),
                  cache = temp_dir("frame_cache");
@@ -166,7 +166,7 @@ TEST(Run, SameBytesWhateverTheThreadCountAndFromTheFrameCache) {
 }
 
 TEST(Run, SameBytesWhateverTheThreadCountWithARollingShutterAndAFreeRunningPair) {
-  // Issue 45: the basin paper's cameras (rolling shutter drawn in bands, the right image at
+  // The basin paper's cameras (rolling shutter drawn in bands, the right image at
   // the run's drawn offset) on waves give the same estimates and per-frame rows at 1 and 2
   // threads.
   const fs::path a = temp_dir("rolling1"), b = temp_dir("rolling2");
@@ -386,19 +386,18 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   }
 
   // Accuracy on frames from the real renderer, shipped defaults (the river paper's Bumblebee2
-  // camera, photographed materials and procedural textures at contrast 2, the reflection pass
-  // at full resolution, the overcast sky with its clouds). Measured on 2026-11-29 with the
-  // overcast sky: sparse_kf e'_p 0.0070 m/m, length +0.1 %, 3D RMSE 0.38 % of the track; sparse
-  // (the paper's frame-to-frame method) 0.0470 m/m, length -2.7 % (the flat sky before, the
-  // same day: 0.0042 and 0.0467 m/m; procedural textures everywhere, 2026-11-26: 0.0045 and
-  // 0.0338 m/m). Two sections make sparse_kf's figure noisy: over seeds 1-3 of a similar leg it
-  // was 0.0071, 0.0043, 0.0052 with the new sky and 0.0032, 0.0032, 0.0068 with the flat one,
-  // and the CI gate's 80 paired sections saw no change (+2.9 %, p = 0.39). With the skeleton
-  // trees and their alpha-tested leaf cards (2026-11-29, the same day): sparse_kf 0.0115 m/m,
-  // length -0.4 %, 3D RMSE 0.61 %; sparse 0.0504 m/m, length -2.1 % (0.0130-0.0147 and
-  // 0.55-0.65 % for versions with more cards; leaf edges alias: with 4x MSAA 0.0052, see
+  // camera, photographed materials and procedural textures at contrast 2, the reflection pass at
+  // full resolution, the overcast sky with its clouds). Measured with the overcast sky: sparse_kf
+  // e'_p 0.0070 m/m, length +0.1 %, 3D RMSE 0.38 % of the track; sparse (the paper's frame-to-frame
+  // method) 0.0470 m/m, length -2.7 % (the flat sky before it: 0.0042 and 0.0467 m/m; procedural
+  // textures everywhere: 0.0045 and 0.0338 m/m). Two sections make sparse_kf's figure noisy: over
+  // seeds 1-3 of a similar leg it was 0.0071, 0.0043, 0.0052 with the new sky and 0.0032, 0.0032,
+  // 0.0068 with the flat one, and the CI gate's 80 paired sections saw no change (+2.9 %,
+  // p = 0.39). With the skeleton trees and their alpha-tested leaf cards: sparse_kf 0.0115 m/m,
+  // length -0.4 %, 3D RMSE 0.61 %; sparse 0.0504 m/m, length -2.1 % (0.0130-0.0147 and 0.55-0.65 %
+  // for versions with more cards; leaf edges alias: with 4x MSAA 0.0052, see
   // docs/renderer-and-scenes.md, Trees). The bounds sit 30 % above the first version's figures
-  // (0.0130, 0.55 %), about 45 % above today's.
+  // (0.0130, 0.55 %), about 45 % above the skeleton trees' (0.0115, 0.61 %).
   auto mean_ep = [&](const char* algo) {
     return m["algorithms"][algo]["sections"]["p_m_per_m"]["mean"].get<double>();
   };

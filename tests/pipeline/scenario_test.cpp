@@ -72,7 +72,7 @@ TEST(Scenario, CameraPresetsAreThePapersCamerasAndLaterKeysOverrideThem) {
   EXPECT_EQ(b.width_px, 640);
   EXPECT_NEAR(2 * std::atan(400 / b.fx_px) * 180 / std::numbers::pi, 75.0, 0.1);
   EXPECT_DOUBLE_EQ(b.rate_hz, 20.0);
-  // Issue 45: its OV7720 has a rolling shutter (a VGA line of 784 pixel clocks at 12 MHz), and
+  // Its OV7720 has a rolling shutter (a VGA line of 784 pixel clocks at 12 MHz), and
   // the two free-running cameras meet within half a 30 fps period; the Bumblebee2's CCDs are
   // global and synchronised.
   EXPECT_EQ(b.shutter, sim::Shutter::kRolling);

@@ -730,7 +730,7 @@ TEST(RiverReach, VisibilitySetsTheHazeByKoschmiedersLaw) {
   }
 }
 
-// Other vessels (scene.river_reach.vessels, issue 46 item 4): each is a mover whose pose is its
+// Other vessels (scene.river_reach.vessels): each is a mover whose pose is its
 // closed-form motion, whose hull stays within its length, beam and draft, and whose options are
 // checked against the river; a reach without vessels is the scene it was.
 // The vegetation's sway weights (sim::Mesh::sway): trees and bushes bend as a cantilever's

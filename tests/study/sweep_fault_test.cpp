@@ -1,4 +1,4 @@
-// Faults in long work (issue 21, item 4): a sweep whose runner is killed at random
+// Faults in long work: a sweep whose runner is killed at random
 // points, whose jobs crash, hang or are killed, and whose disk fills up must
 //  - never leave a result that looks complete and is not (every runs/ID is the
 //    byte-for-byte result of an undisturbed run of the same plan),

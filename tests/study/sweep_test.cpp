@@ -851,7 +851,7 @@ TEST(RunRegressions, AConditionFitsOnlyTheRunsWithThatValue) {
 }
 
 TEST(SweepCli, BuiltInAndExternalVoSideBySideMergeIntoOneTable) {
-  // Issue 17: an external VO (here driftlab's own sparse VO behind a command) in every job.
+  // An external VO (here driftlab's own sparse VO behind a command) in every job.
   const fs::path root = temp_dir("external");
   fs::create_directories(root);
   const std::string script = (kSource / "tests/data/external_vo/driftlab_sparse.sh").string();
@@ -884,7 +884,7 @@ TEST(SweepCli, BuiltInAndExternalVoSideBySideMergeIntoOneTable) {
 }
 
 TEST(SweepCli, JobsDifferingOnlyInVoOptionsRenderTheirFramesOnce) {
-  // Issue 43: two VO settings x two replicates, two jobs at once, one frame cache: each
+  // Two VO settings x two replicates, two jobs at once, one frame cache: each
   // replicate's frames (its seed) are rendered by one job and replayed by the other, even when
   // both start together. Then the merge's paired comparisons of the VOs and of the settings.
   const fs::path root = temp_dir("vo_only");
