@@ -9,9 +9,9 @@ if(DRIFTLAB_SANITIZE)
   add_compile_options(-fsanitize=${san} -fno-omit-frame-pointer -fno-sanitize-recover=all)
   # -O2 -g1 after the build type's flags (the last -O and -g win): line tables for the reports
   # (full -g cost most of the compile time: fusion/eskf.cpp with ASan and UBSan 114 s at -O2 -g,
-  # 62 s at -O1 -g1, 2026-11-27). -O2 rather than ASan's suggested -O1: clang compiles scenes/
+  # 62 s at -O1 -g1). -O2 rather than ASan's suggested -O1: clang compiles scenes/
   # as fast at either, and at -O1 leaves Eigen's small vectors uninlined (a river scene and one
-  # frame: 5.9 s at -O1, 3.9 s at -O2, 2026-11-30).
+  # frame: 5.9 s at -O1, 3.9 s at -O2).
   add_compile_options(-O2 -g1)
   add_link_options(-fsanitize=${san})
   message(STATUS "driftlab: sanitizers ${san}")

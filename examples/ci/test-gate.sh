@@ -1,18 +1,18 @@
 #!/usr/bin/env bash
-# The gate's own test (issue 43): run-gate.sh must fail (exit 5, naming the metrics that
-# regressed) on changes that make the sparse VO worse, and pass changes that do not. The gate
-# judges metrics, never settings: each change reaches it only through the VO's results.
+# The gate's own test (docs/sweeps.md, the CI regression gate): run-gate.sh must fail (exit 5,
+# naming the metrics that regressed) on changes that make the sparse VO worse, and pass changes
+# that do not. The gate judges metrics, never settings: each change reaches it only through the
+# VO's results.
 #   pipeline.sparse.lk_refinement=false        no sub-pixel refinement of the matches: must fail
 #   pipeline.sparse.ransac_iterations=8        too few RANSAC iterations: must fail
 #   pipeline.sparse.gauss_newton_step_tolerance=1e-12   a tighter stop of the converged Gauss-Newton
 #                                              minimisation of Eq. (2) (it moves the metrics in
 #                                              their last digits, -0.0 %, p 0.99): must pass
-# (until 2026-12-02 the harmless change was ransac_iterations=100, twice the paper's; with the
-# bank's defaults of that day (stones, far trees, reed cards, 45 leaf cards, 9 km haze) it is no
-# longer harmless: sparse e'_p +18 %, p = 0.005 over 80 paired sections, rotation RMSE +40 %,
-# and the gate says so. Why more iterations err more on the new bank is not measured yet.)
-# (until 2026-11-29 the harmless change was descriptor_window_px=5; on the bank with leafy trees
-# a 5x5 window is no longer harmless: sparse e'_p +62 %, p = 0.00076, and the gate says so.)
+# (ransac_iterations=100, twice the paper's, is not the harmless change: on the bank with its
+# stones, far trees, reed cards, 45 leaf cards and 9 km haze it gave sparse e'_p +18 %, p = 0.005
+# over 80 paired sections, rotation RMSE +40 %, and the gate says so; why: docs/sweeps.md,
+# "RANSAC's score: counting inliers against MSAC". Nor is descriptor_window_px=5: on the bank
+# with leafy trees a 5x5 window gave sparse e'_p +62 %, p = 0.00076, and the gate says so.)
 # Output that is the same bytes passes: run-gate.sh itself shows that, against the baseline, on
 # every CI run (so the earlier `pipeline.threads=1` case, a gate run of its own, was dropped).
 # `scripts/test` runs it after run-gate.sh, so the frames come from the frame cache. The cases
