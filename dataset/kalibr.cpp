@@ -25,14 +25,18 @@ void copy_key(const YAML::Node& from, const char* from_key, YAML::Node* to, cons
   if (from[from_key]) (*to)[to_key] = from[from_key];
 }
 
-// A 4x4 matrix as Kalibr writes it: a block list of rows, `indent` spaces in.
-std::string kalibr_matrix(const SE3& T, int indent) {
-  const Eigen::Matrix4d m = matrix_4x4(T);
+// A matrix as Kalibr writes it: a block list of rows, `indent` spaces in.
+std::string kalibr_rows(const Eigen::MatrixXd& m, int indent) {
   std::string out;
-  for (int r = 0; r < 4; ++r)
+  for (Eigen::Index r = 0; r < m.rows(); ++r)
     out += fmt::format("{:{}}- [{}]\n", "", indent, matrix_text(m.row(r), ", "));
   return out;
 }
+
+// The first lines of a Kalibr chain: a YAML directive, which OpenCV's FileStorage (OpenVINS's
+// reader) needs as the file's first bytes to take it for YAML, and which YAML 1.1 readers
+// (Kalibr's Python, yaml-cpp) accept before a document marker.
+constexpr const char* kKalibrHead = "%YAML 1.0\n---\n";
 
 std::string opencv_matrix(const SE3& T) {
   return fmt::format("!!opencv-matrix\n   rows: 4\n   cols: 4\n   dt: d\n   data: [{}]\n",
@@ -71,11 +75,15 @@ SE3 kalibr_T_B_C(const YAML::Node& cam, const fs::path& path, const std::string&
 std::string kalibr_imucam_chain_yaml(const ExportCalibration& cal) {
   const PinholeCamera& c = cal.rig.camera;
   std::string out = fmt::format(
-      "# driftlab export ({}): the rectified pair, Kalibr's camera chain\n", cal.source);
+      "{}# driftlab export ({}): the rectified pair, Kalibr's camera chain (T_cam_imu, and its "
+      "inverse T_imu_cam, which OpenVINS reads)\n",
+      kKalibrHead, cal.source);
   for (int i = 0; i < 2; ++i) {
     const SE3 T_S_Ci = i == 0 ? cal.T_S_C : cal.T_S_C * T_C0_C1(cal);
-    out += fmt::format("cam{}:\n  T_cam_imu:\n{}", i, kalibr_matrix(T_S_Ci.inverse(), 4));
-    if (i == 1) out += "  T_cn_cnm1:\n" + kalibr_matrix(T_C0_C1(cal).inverse(), 4);
+    out += fmt::format("cam{}:\n  T_cam_imu:\n{}  T_imu_cam:\n{}", i,
+                       kalibr_rows(matrix_4x4(T_S_Ci.inverse()), 4),
+                       kalibr_rows(matrix_4x4(T_S_Ci), 4));
+    if (i == 1) out += "  T_cn_cnm1:\n" + kalibr_rows(matrix_4x4(T_C0_C1(cal).inverse()), 4);
     out += fmt::format(
         "  cam_overlaps: [{}]\n  camera_model: pinhole\n  distortion_coeffs: [0.0, 0.0, 0.0, "
         "0.0]\n  distortion_model: radtan\n  intrinsics: [{}, {}, {}, {}]\n  resolution: [{}, "
@@ -86,13 +94,19 @@ std::string kalibr_imucam_chain_yaml(const ExportCalibration& cal) {
 }
 
 std::string kalibr_imu_chain_yaml(const ImuNoiseModel& m) {
+  // OpenVINS requires its intrinsic matrices beside Kalibr's keys (gyroscope Tw and
+  // R_IMUtoGYRO, accelerometer Ta and R_IMUtoACC, g-sensitivity Tg): the nominal ones here.
+  const std::string I = kalibr_rows(Mat3::Identity(), 4), zero = kalibr_rows(Mat3::Zero(), 4);
   return fmt::format(
-      "# driftlab export: the scenario's IMU, Kalibr's IMU chain (continuous-time densities)\n"
+      "{}# driftlab export: the scenario's IMU, Kalibr's IMU chain (continuous-time densities), "
+      "with OpenVINS's nominal intrinsics\n"
       "imu0:\n  T_i_b:\n{}  accelerometer_noise_density: {}\n  accelerometer_random_walk: {}\n"
       "  gyroscope_noise_density: {}\n  gyroscope_random_walk: {}\n  model: calibrated\n"
-      "  rostopic: {}\n  time_offset: 0.0\n  update_rate: {}\n",
-      kalibr_matrix(SE3(), 4), g(m.accelerometer_noise_density), g(m.accelerometer_random_walk),
-      g(m.gyroscope_noise_density), g(m.gyroscope_random_walk), names::kImu, g(m.rate_hz));
+      "  rostopic: {}\n  time_offset: 0.0\n  update_rate: {}\n  Tw:\n{}  R_IMUtoGYRO:\n{}"
+      "  Ta:\n{}  R_IMUtoACC:\n{}  Tg:\n{}",
+      kKalibrHead, kalibr_rows(matrix_4x4(SE3()), 4), g(m.accelerometer_noise_density),
+      g(m.accelerometer_random_walk), g(m.gyroscope_noise_density), g(m.gyroscope_random_walk),
+      names::kImu, g(m.rate_hz), I, I, I, I, zero);
 }
 
 std::vector<std::pair<std::string, std::string>> vins_fusion_files(const ExportCalibration& cal) {

@@ -238,6 +238,45 @@ TEST(RosbagExport, PythonsRosbagReadsEveryMessageWithItsStampsAndValues) {
   fs::remove_all(root);
 }
 
+// Row r, column c of a matrix written as a block list of rows, read through OpenCV's FileNode
+// as OpenVINS's YAML parser reads it.
+double kalibr_entry(const cv::FileNode& rows, int r, int c) {
+  return static_cast<double>(rows[r][c]);
+}
+
+TEST(RosbagExport, OpenVinsReaderOpenCvFileStorageReadsTheKalibrChains) {
+  // OpenVINS opens both chains with cv::FileStorage, which takes a file for YAML only when it
+  // starts with a %YAML directive, and reads cam0/cam1 T_imu_cam (the camera in the IMU frame)
+  // and the IMU's Tw, R_IMUtoGYRO, Ta, R_IMUtoACC and Tg, every one required.
+  const fs::path root = test::fresh_temp_dir("kalibr_opencv");
+  const BagSequence seq(root / "staging");
+  seq.write(*make_writer(DatasetFormat::kRosbag, root, bag_calibration()));
+  cv::FileStorage cams((root / "kalibr_imucam_chain.yaml").string(), cv::FileStorage::READ);
+  ASSERT_TRUE(cams.isOpened());
+  for (int i = 0; i < 2; ++i) {
+    const cv::FileNode T = cams[fmt::format("cam{}", i)]["T_imu_cam"];
+    ASSERT_EQ(T.size(), 4u);
+    const SE3 T_S_Ci = bag_calibration().T_S_C * SE3(Mat3::Identity(), Vec3(0.25 * i, 0, 0));
+    const Eigen::Matrix4d expected = T_S_Ci.matrix();
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) EXPECT_NEAR(kalibr_entry(T, r, c), expected(r, c), 1e-15);
+    EXPECT_EQ(static_cast<std::string>(cams[fmt::format("cam{}", i)]["camera_model"]), "pinhole");
+  }
+  cv::FileStorage imu((root / "kalibr_imu_chain.yaml").string(), cv::FileStorage::READ);
+  ASSERT_TRUE(imu.isOpened());
+  const cv::FileNode imu0 = imu["imu0"];
+  EXPECT_DOUBLE_EQ(static_cast<double>(imu0["gyroscope_random_walk"]), 2e-5);
+  for (const char* key : {"Tw", "R_IMUtoGYRO", "Ta", "R_IMUtoACC", "Tg"}) {
+    const cv::FileNode m = imu0[key];
+    ASSERT_EQ(m.size(), 3u) << key;
+    const bool identity = std::string(key) != "Tg";
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(kalibr_entry(m, r, c), identity && r == c ? 1.0 : 0.0) << key;
+  }
+  fs::remove_all(root);
+}
+
 TEST(Rosbag2Export, ADecoderOfItsOwnFindsEveryMessageInTheDatabase) {
   const fs::path root = test::fresh_temp_dir("rosbag2_export");
   const BagSequence seq(root / "staging");
