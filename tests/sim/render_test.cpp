@@ -397,7 +397,7 @@ TEST(Render, SubPixelMotionOfOutlinesAndReflectionsKeepsItsSize) {
   const SubPixelShiftError shipped = sub_pixel_shift_error(RenderOptions{});
   EXPECT_LT(shipped.direct_px, 0.08);
   EXPECT_LT(shipped.mirror_px, 0.08);
-  // A half-resolution mirror pass (the default until 2026-11-25) snaps the
+  // A half-resolution mirror pass (`reflection_resolution: half`) snaps the
   // motion to its 2 px texels, and 4x MSAA in it only halves that.
   RenderOptions half;
   half.reflection_resolution = ReflectionResolution::kHalf;
@@ -801,7 +801,7 @@ SceneGeometry movers_scene(std::size_t* statics) {
   return with;
 }
 
-// The moving things' mask (issue 46, item 5): a mover's mask is exactly the pixels whose depth
+// The moving things' mask: a mover's mask is exactly the pixels whose depth
 // differs from a render of the scene without it (a second method), over water (its part under
 // the waterline is hidden) and behind a static wall that hides a part of it; and the mover is
 // where its closed-form motion puts it: a square facing the camera, moving east, has its mask's
@@ -962,7 +962,7 @@ TEST(Render, BadRigIsAClearError) {
 
 TEST(Render, MixingBackendsIsAClearError) {
   // Mesa's OSMesa and its EGL driver share one dispatch: an OSMesa renderer used after an EGL
-  // one was created reads back wrong frames (a depth image of zeros, measured 2026-11-26), so a
+  // one was created reads back wrong frames (a depth image of zeros), so a
   // second backend in one process is refused, naming both; after the first is gone it works.
   RenderOptions egl;
   egl.backend = RenderBackend::kEgl;
