@@ -57,6 +57,16 @@ class Rng {
 /// The seed of the stream `name` under `seed` (algorithm in the file comment).
 std::uint64_t derive_seed(std::uint64_t seed, std::string_view name);
 
+/// SplitMix64's finaliser: a full-avalanche 64-bit mix (nearby inputs, unrelated outputs).
+constexpr std::uint64_t mix64(std::uint64_t z) {
+  z ^= z >> 30;
+  z *= 0xbf58476d1ce4e5b9ULL;
+  z ^= z >> 27;
+  z *= 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return z;
+}
+
 /// The named streams of one scenario run.
 class RngStreams {
  public:

@@ -15,6 +15,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
+#include "core/enum_names.hpp"
 #include "core/error.hpp"
 
 namespace driftlab {
@@ -309,27 +310,12 @@ const Columns kEurocImuColumns{
 // Format names
 
 TrajectoryFormat format_from_name(std::string_view name) {
-  std::string lower(name);
-  for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  if (lower == "tum") return TrajectoryFormat::kTum;
-  if (lower == "kitti") return TrajectoryFormat::kKitti;
-  if (lower == "euroc") return TrajectoryFormat::kEuroc;
-  throw UserError(fmt::format(
-      "unknown trajectory format: got '{}', expected one of: tum, kitti, euroc", shown(name)));
+  if (const auto f = yaml::enum_from_name_any_case<TrajectoryFormat>(name)) return *f;
+  throw UserError(fmt::format("unknown trajectory format: got '{}', expected one of: {}",
+                              shown(name), yaml::enum_choices<TrajectoryFormat>()));
 }
 
-std::string_view format_name(TrajectoryFormat format) {
-  switch (format) {
-    case TrajectoryFormat::kTum:
-      return "tum";
-    case TrajectoryFormat::kKitti:
-      return "kitti";
-    case TrajectoryFormat::kEuroc:
-      return "euroc";
-  }
-  DRIFTLAB_DEMAND_MSG(false, "unknown TrajectoryFormat value");
-  return {};
-}
+std::string_view format_name(TrajectoryFormat format) { return yaml::enum_name(format); }
 
 // ---------------------------------------------------------------------------
 // TUM

@@ -49,6 +49,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/enum_names.hpp"
 #include "core/error.hpp"
 #include "core/yaml_rules.hpp"
 
@@ -178,39 +179,6 @@ struct is_vector_of_visitable<std::vector<T, Alloc>> : std::true_type {};
 
 template <class T>
 concept OptionalOfVisitable = is_std_optional<T>::value && Visitable<typename T::value_type>;
-
-template <class T>
-concept Enum = std::is_enum_v<T> && requires(T e) {
-  enum_table(e);
-};
-
-/// Name of an enum value from its ADL enum_table.
-template <Enum E>
-std::string_view enum_name(E value) {
-  for (const auto& [v, name] : enum_table(E{}))
-    if (v == value) return name;
-  DRIFTLAB_DEMAND_MSG(false, "enum value without a name in enum_table");
-  return {};
-}
-
-/// Comma-separated list of an enum's names, for "expected one of ..." messages.
-template <Enum E>
-std::string enum_choices() {
-  std::string out;
-  for (const auto& [v, name] : enum_table(E{})) {
-    if (!out.empty()) out += ", ";
-    out += name;
-  }
-  return out;
-}
-
-/// Parses an enum by name; returns nullopt if unknown.
-template <Enum E>
-std::optional<E> enum_from_name(std::string_view text) {
-  for (const auto& [v, name] : enum_table(E{}))
-    if (text == name) return v;
-  return std::nullopt;
-}
 
 // The rules and locations every archive accepts; those that do not act on them inherit
 // these no-ops.

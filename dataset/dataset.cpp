@@ -20,33 +20,12 @@ namespace driftlab::dataset {
 namespace fs = std::filesystem;
 
 DatasetFormat format_from_name(std::string_view name) {
-  std::string lower(name);
-  for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  if (lower == "kitti") return DatasetFormat::kKitti;
-  if (lower == "euroc") return DatasetFormat::kEuroc;
-  if (lower == "tum-rgbd") return DatasetFormat::kTumRgbd;
-  if (lower == "rosbag") return DatasetFormat::kRosbag;
-  if (lower == "rosbag2") return DatasetFormat::kRosbag2;
-  throw UserError(fmt::format(
-      "unknown dataset format: got '{}', expected one of: kitti, euroc, tum-rgbd, rosbag, rosbag2",
-      name));
+  if (const auto f = yaml::enum_from_name_any_case<DatasetFormat>(name)) return *f;
+  throw UserError(fmt::format("unknown dataset format: got '{}', expected one of: {}", name,
+                              yaml::enum_choices<DatasetFormat>()));
 }
 
-std::string_view format_name(DatasetFormat format) {
-  switch (format) {
-    case DatasetFormat::kKitti:
-      return "kitti";
-    case DatasetFormat::kEuroc:
-      return "euroc";
-    case DatasetFormat::kTumRgbd:
-      return "tum-rgbd";
-    case DatasetFormat::kRosbag:
-      return "rosbag";
-    case DatasetFormat::kRosbag2:
-      return "rosbag2";
-  }
-  return "?";
-}
+std::string_view format_name(DatasetFormat format) { return yaml::enum_name(format); }
 
 std::unique_ptr<DatasetWriter> make_writer(DatasetFormat format, const fs::path& root,
                                            const ExportCalibration& calibration) {

@@ -16,6 +16,16 @@ namespace driftlab::scenes {
 
 using Vec3 = Eigen::Vector3d;
 
+/// A material of texture `texture` (-1: none), `albedo` and sun-glint `specular`, seen from
+/// both sides.
+inline sim::Material material(int texture, float albedo, float specular = 0.0f) {
+  sim::Material m;
+  m.texture = texture;
+  m.albedo = albedo;
+  m.specular = specular;
+  return m;
+}
+
 class MeshBuilder {
  public:
   MeshBuilder(std::string name, sim::Material material);

@@ -3,20 +3,11 @@
 #include <array>
 #include <cmath>
 
+#include "core/rng.hpp"
+
 namespace driftlab::scenes {
 
 namespace {
-
-// SplitMix64 finaliser: a full-avalanche 64-bit mix, so neighbouring lattice
-// points get unrelated values.
-constexpr std::uint64_t mix64(std::uint64_t z) {
-  z ^= z >> 30;
-  z *= 0xbf58476d1ce4e5b9ULL;
-  z ^= z >> 27;
-  z *= 0x94d049bb133111ebULL;
-  z ^= z >> 31;
-  return z;
-}
 
 std::int64_t wrap(std::int64_t i, int period) {
   if (period <= 0) return i;

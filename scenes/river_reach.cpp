@@ -97,14 +97,6 @@ std::string tile_name(int index, const char* what) {
   return "tile" + std::to_string(index) + "." + what;
 }
 
-sim::Material material(int texture, float albedo, float specular = 0.0f) {
-  sim::Material m;
-  m.texture = texture;
-  m.albedo = albedo;
-  m.specular = specular;
-  return m;
-}
-
 // The material of a surface that bounds a solid: its back faces are never seen.
 sim::Material solid(int texture, float albedo) {
   sim::Material m = material(texture, albedo);

@@ -18,14 +18,6 @@ constexpr double kGeneratorDepth_m = 0.6;  // housing behind the paddle
 constexpr double kCrestHeight_m = 0.25;    // beach crest and platform above the still water
 constexpr double kDadoHeight_m = 0.5;      // the tank wall's darker band above the water
 
-sim::Material material(int texture, float albedo, float specular = 0.0f) {
-  sim::Material m;
-  m.texture = texture;
-  m.albedo = albedo;
-  m.specular = specular;
-  return m;
-}
-
 }  // namespace
 
 BasinLayout basin_layout(const WaveBasinOptions& o) {
