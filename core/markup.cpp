@@ -29,4 +29,10 @@ std::string markup_escape(std::string_view text, MarkupQuotes quotes) {
   return out;
 }
 
+std::string markdown_cell(std::string_view text) {
+  std::string out;
+  for (char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
+  return out;
+}
+
 }  // namespace driftlab

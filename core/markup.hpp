@@ -1,5 +1,5 @@
-// Text into XML and HTML (JUnit reports of the gate, the run report's HTML): one escape for
-// every markup driftlab writes.
+// Text into XML, HTML and Markdown tables (JUnit reports of the gate, the run report's HTML,
+// the generated references): one escape for every markup driftlab writes.
 #pragma once
 
 #include <string>
@@ -14,5 +14,8 @@ enum class MarkupQuotes { kBoth, kDoubleOnly };
 /// `text` with & < > " (and with kBoth ') written as entities (&amp; &lt; &gt; &quot;
 /// &apos;).
 std::string markup_escape(std::string_view text, MarkupQuotes quotes = MarkupQuotes::kBoth);
+
+/// `text` for one cell of a Markdown table: each | written as \\|.
+std::string markdown_cell(std::string_view text);
 
 }  // namespace driftlab

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/file_io.hpp"
+#include "core/markup.hpp"
 
 namespace driftlab::yaml {
 
@@ -600,11 +601,7 @@ std::string Any::flow_text() const {
 }
 
 std::string schema_markdown(const std::vector<SchemaRow>& rows) {
-  auto cell = [](std::string s) {
-    std::string out;
-    for (char c : s) out += c == '|' ? std::string("\\|") : std::string(1, c);
-    return out;
-  };
+  const auto cell = [](const std::string& s) { return markdown_cell(s); };
   std::string out = "| key | type | default | constraint | meaning |\n|---|---|---|---|---|\n";
   for (const auto& r : rows) {
     out += fmt::format("| `{}` | {} | {} | {} | {} |\n", r.key_path, cell(r.type),

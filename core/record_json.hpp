@@ -1,0 +1,340 @@
+// Typed records <-> JSON, driven by the same visit() lists as the options (core/yaml_io.hpp).
+//
+// A record lists its fields once:
+//
+//   struct TrackRecord {
+//     std::size_t n = 0;
+//     double rmse_3d_m = 0;
+//     template <class A> void visit(A& a) {
+//       a("n", n, "poses compared");
+//       a("rmse_3d_m", rmse_3d_m, "3D position error, RMS [m]");
+//     }
+//   };
+//
+// and that one list writes it (record_json::to_json), reads it back strictly
+// (record_json::from_json: a wrong type or an unknown key is an error naming the source, the
+// key path, the value and what was expected) and documents it (record_json::fields_of, for
+// docs/metrics-reference.md). A visit() may call a member's visit() to lay its fields out
+// flat in the same object.
+//
+// Field types: bool, integers, double, std::string, enums with an ADL `enum_table` (by
+// name), nested records, std::vector<T>, std::array<T, N>, std::map<std::string, T> (an
+// object of names of the run's choosing), std::optional<T> (absent when empty; null reads as
+// empty) and
+// nlohmann::json (any JSON, kept as it is). A double that is not finite is written as null,
+// and the writer names it; null reads back as NaN.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/yaml_io.hpp"
+
+namespace driftlab::record_json {
+
+template <class T>
+struct is_string_map : std::false_type {};
+template <class T, class Cmp, class Alloc>
+struct is_string_map<std::map<std::string, T, Cmp, Alloc>> : std::true_type {};
+
+/// A number the writer wrote as null, by its key path ("ape.trans_m.rmse").
+struct NonFinite {
+  std::string key;
+  double value = 0;
+};
+
+// ---------------------------------------------------------------------------
+// Writer: every field, under its key; nlohmann's objects keep their keys sorted.
+
+class Writer : public yaml::IgnoresRules {
+ public:
+  Writer(nlohmann::json* out, std::string prefix, std::vector<NonFinite>* nonfinite)
+      : out_(out), prefix_(std::move(prefix)), nonfinite_(nonfinite) {}
+
+  template <class T>
+  void operator()(const char* key, const T& value, const char*, const yaml::Check& = {}) {
+    if constexpr (yaml::is_std_optional<T>::value) {
+      if (!value) return;
+    }
+    (*out_)[key] = value_json(value, path(key), nonfinite_);
+  }
+
+  template <class T>
+  static nlohmann::json value_json(const T& value, const std::string& at,
+                                   std::vector<NonFinite>* nonfinite);
+
+ private:
+  std::string path(const char* key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
+
+  nlohmann::json* out_;
+  std::string prefix_;
+  std::vector<NonFinite>* nonfinite_;
+};
+
+template <class T>
+nlohmann::json Writer::value_json(const T& value, const std::string& at,
+                                  std::vector<NonFinite>* nonfinite) {
+  if constexpr (yaml::is_std_optional<T>::value) {
+    return value ? value_json(*value, at, nonfinite) : nlohmann::json();
+  } else if constexpr (std::is_same_v<T, nlohmann::json>) {
+    return value;
+  } else if constexpr (std::is_same_v<T, double>) {
+    if (!std::isfinite(value) && nonfinite) nonfinite->push_back({at, value});
+    return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
+  } else if constexpr (std::is_same_v<T, bool> || std::is_integral_v<T> ||
+                       std::is_same_v<T, std::string>) {
+    return value;
+  } else if constexpr (yaml::Enum<T>) {
+    return std::string(yaml::enum_name(value));
+  } else if constexpr (yaml::Visitable<T>) {
+    nlohmann::json j = nlohmann::json::object();
+    Writer sub(&j, at, nonfinite);
+    const_cast<T&>(value).visit(sub);  // the writer only reads the fields
+    return j;
+  } else if constexpr (is_string_map<T>::value) {
+    nlohmann::json j = nlohmann::json::object();
+    for (const auto& [name, v] : value) j[name] = value_json(v, at + "." + name, nonfinite);
+    return j;
+  } else if constexpr (yaml::is_std_vector<T>::value || yaml::is_std_array<T>::value) {
+    nlohmann::json j = nlohmann::json::array();
+    for (std::size_t i = 0; i < value.size(); ++i)
+      j.push_back(value_json(value[i], at + "[" + std::to_string(i) + "]", nonfinite));
+    return j;
+  } else {
+    static_assert(sizeof(T) == 0, "unsupported record field type");
+  }
+}
+
+/// The record as JSON; each number written as null is added to `nonfinite` when given.
+template <yaml::Visitable T>
+nlohmann::json to_json(const T& record, std::vector<NonFinite>* nonfinite = nullptr) {
+  return Writer::value_json(record, "", nonfinite);
+}
+
+// ---------------------------------------------------------------------------
+// Reader: strict on types and keys; an absent key keeps the field's default (an older file
+// without a newer block), an absent optional stays empty.
+
+class Reader : public yaml::IgnoresRules {
+ public:
+  Reader(const nlohmann::json& in, std::string source, std::string prefix)
+      : in_(in), source_(std::move(source)), prefix_(std::move(prefix)) {}
+
+  template <class T>
+  void operator()(const char* key, T& value, const char*, const yaml::Check& = {}) {
+    seen_.insert(key);
+    const auto it = in_.find(key);
+    if (it == in_.end()) return;
+    read(*it, path(key), &value);
+  }
+  /// Fails on a key that no field of the record names.
+  void reject_unknown_keys() const;
+
+  template <class T>
+  void read(const nlohmann::json& j, const std::string& at, T* value) const;
+
+ private:
+  std::string path(const char* key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
+  [[noreturn]] void fail(const nlohmann::json& j, const std::string& at,
+                         const std::string& expected) const;
+  template <class T>
+  static std::string expected();
+
+  const nlohmann::json& in_;
+  std::string source_, prefix_;
+  std::set<std::string> seen_;
+};
+
+template <class T>
+std::string Reader::expected() {
+  if constexpr (std::is_same_v<T, double>) {
+    return "a number or null";
+  } else if constexpr (std::is_same_v<T, bool>) {
+    return "true or false";
+  } else if constexpr (std::is_integral_v<T> && std::is_unsigned_v<T>) {
+    return "a whole number >= 0";
+  } else if constexpr (std::is_integral_v<T>) {
+    return "a whole number";
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    return "a string";
+  } else if constexpr (yaml::Enum<T>) {
+    return "one of " + yaml::enum_choices<T>();
+  } else if constexpr (yaml::Visitable<T> || is_string_map<T>::value) {
+    return "an object";
+  } else {
+    return "a list";
+  }
+}
+
+template <class T>
+void Reader::read(const nlohmann::json& j, const std::string& at, T* value) const {
+  if constexpr (yaml::is_std_optional<T>::value) {
+    if (j.is_null()) {
+      value->reset();
+      return;
+    }
+    typename T::value_type inner{};
+    read(j, at, &inner);
+    *value = std::move(inner);
+  } else if constexpr (std::is_same_v<T, nlohmann::json>) {
+    *value = j;
+  } else if constexpr (std::is_same_v<T, double>) {
+    if (j.is_null()) {
+      *value = std::numeric_limits<double>::quiet_NaN();
+    } else {
+      if (!j.is_number()) fail(j, at, expected<T>());
+      *value = j.get<double>();
+    }
+  } else if constexpr (std::is_same_v<T, bool>) {
+    if (!j.is_boolean()) fail(j, at, expected<T>());
+    *value = j.get<bool>();
+  } else if constexpr (std::is_integral_v<T>) {
+    const bool ok = j.is_number_integer() && (!std::is_unsigned_v<T> || j.is_number_unsigned() ||
+                                              j.get<std::int64_t>() >= 0);
+    if (!ok) fail(j, at, expected<T>());
+    *value = j.get<T>();
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    if (!j.is_string()) fail(j, at, expected<T>());
+    *value = j.get<std::string>();
+  } else if constexpr (yaml::Enum<T>) {
+    const auto e = j.is_string() ? yaml::enum_from_name<T>(j.get<std::string>()) : std::nullopt;
+    if (!e) fail(j, at, expected<T>());
+    *value = *e;
+  } else if constexpr (yaml::Visitable<T>) {
+    if (!j.is_object()) fail(j, at, expected<T>());
+    Reader sub(j, source_, at);
+    value->visit(sub);
+    sub.reject_unknown_keys();
+  } else if constexpr (is_string_map<T>::value) {
+    if (!j.is_object()) fail(j, at, expected<T>());
+    value->clear();
+    for (const auto& [name, v] : j.items()) read(v, at + "." + name, &(*value)[name]);
+  } else if constexpr (yaml::is_std_vector<T>::value) {
+    if (!j.is_array()) fail(j, at, expected<T>());
+    value->assign(j.size(), typename T::value_type{});
+    for (std::size_t i = 0; i < j.size(); ++i)
+      read(j[i], at + "[" + std::to_string(i) + "]", &(*value)[i]);
+  } else if constexpr (yaml::is_std_array<T>::value) {
+    if (!j.is_array() || j.size() != value->size())
+      fail(j, at, "a list of " + std::to_string(value->size()));
+    for (std::size_t i = 0; i < j.size(); ++i)
+      read(j[i], at + "[" + std::to_string(i) + "]", &(*value)[i]);
+  } else {
+    static_assert(sizeof(T) == 0, "unsupported record field type");
+  }
+}
+
+/// Reads a record written by to_json; `source` names the file in errors. Throws UserError.
+template <yaml::Visitable T>
+T from_json(const nlohmann::json& j, const std::string& source) {
+  T record{};
+  Reader(j, source, "").read(j, "", &record);
+  return record;
+}
+
+// ---------------------------------------------------------------------------
+// Reference: one row per field, for the generated documentation.
+
+struct FieldRow {
+  std::string key_path;
+  std::string type;
+  std::string doc;
+};
+
+class Documenter : public yaml::IgnoresRules {
+ public:
+  Documenter(std::string prefix, std::vector<FieldRow>* rows)
+      : prefix_(std::move(prefix)), rows_(rows) {}
+
+  template <class T>
+  void operator()(const char* key, const T&, const char* doc, const yaml::Check& = {}) {
+    add<T>(prefix_.empty() ? key : prefix_ + "." + key, doc, false);
+  }
+
+ private:
+  template <class T>
+  void add(const std::string& at, const char* doc, bool optional);
+  template <class T>
+  static std::string type_name();
+
+  std::string prefix_;
+  std::vector<FieldRow>* rows_;
+};
+
+template <class T>
+std::string Documenter::type_name() {
+  if constexpr (std::is_same_v<T, nlohmann::json>) {
+    return "any JSON";
+  } else if constexpr (std::is_same_v<T, double>) {
+    return "number";
+  } else if constexpr (std::is_same_v<T, bool>) {
+    return "bool";
+  } else if constexpr (std::is_integral_v<T>) {
+    return "integer";
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    return "string";
+  } else if constexpr (yaml::Enum<T>) {
+    return "one of: " + yaml::enum_choices<T>();
+  } else if constexpr (yaml::Visitable<T>) {
+    return "object";
+  } else if constexpr (is_string_map<T>::value) {
+    return "object of names to " + type_name<typename T::mapped_type>();
+  } else if constexpr (yaml::is_std_array<T>::value) {
+    return "list of " + std::to_string(std::tuple_size_v<T>) + " " +
+           type_name<typename T::value_type>();
+  } else if constexpr (yaml::is_std_vector<T>::value) {
+    return "list of " + type_name<typename T::value_type>();
+  } else {
+    static_assert(sizeof(T) == 0, "unsupported record field type");
+  }
+}
+
+template <class T>
+void Documenter::add(const std::string& at, const char* doc, bool optional) {
+  if constexpr (yaml::is_std_optional<T>::value) {
+    add<typename T::value_type>(at, doc, true);
+  } else {
+    rows_->push_back({at, type_name<T>() + (optional ? " or absent" : ""), doc});
+    if constexpr (yaml::Visitable<T>) {
+      Documenter sub(at, rows_);
+      T{}.visit(sub);
+    } else if constexpr (is_string_map<T>::value) {
+      using V = typename T::mapped_type;
+      if constexpr (yaml::Visitable<V>) {
+        Documenter sub(at + ".NAME", rows_);
+        V{}.visit(sub);
+      }
+    } else if constexpr (yaml::is_std_vector<T>::value || yaml::is_std_array<T>::value) {
+      using V = typename T::value_type;
+      if constexpr (yaml::Visitable<V>) {
+        Documenter sub(at + "[]", rows_);
+        V{}.visit(sub);
+      }
+    }
+  }
+}
+
+/// Rows describing every field of T.
+template <yaml::Visitable T>
+std::vector<FieldRow> fields_of() {
+  std::vector<FieldRow> rows;
+  Documenter d("", &rows);
+  T{}.visit(d);
+  return rows;
+}
+
+/// Markdown table of field rows: key, type, meaning.
+std::string fields_markdown(const std::vector<FieldRow>& rows);
+
+}  // namespace driftlab::record_json
