@@ -32,6 +32,7 @@
 #include "pipeline/run.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/scenario_checks.hpp"
+#include "record/run_record.hpp"
 
 #ifndef DRIFTLAB_VERSION
 #define DRIFTLAB_VERSION "unknown"
@@ -209,6 +210,32 @@ struct ScenarioVerbs : Pinned {
   std::string schema_out;
 };
 
+// metrics schema
+struct MetricsVerbs : Pinned {
+  explicit MetricsVerbs(CLI::App& app) {
+    auto* metrics_cmd = app.add_subcommand("metrics", "Document a run's metrics.json");
+    metrics_cmd->require_subcommand(1);
+    schema_cmd = metrics_cmd->add_subcommand(
+        "schema", "Print the reference of every metrics.json key (Markdown)");
+    schema_cmd->add_option("--out", schema_out, "Write to this file instead of standard output");
+  }
+
+  std::optional<int> dispatch() const {
+    if (!schema_cmd->parsed()) return std::nullopt;
+    return driftlab::app::print_reference(
+        "Metrics reference", "driftlab metrics schema",
+        "Every key of a run's metrics.json (`driftlab run`, `driftlab vo`), with its type and "
+        "meaning. NAME stands for a name the run chose (a track, a covariate, a reason), [] for "
+        "each element of a list. A number that could not be computed is null, and the run's "
+        "warnings name it. A file without `metrics_version` is version 1 (the same keys); a "
+        "newer version than this driftlab's is refused.",
+        driftlab::record::metrics_reference_markdown(), schema_out);
+  }
+
+  CLI::App* schema_cmd = nullptr;
+  std::string schema_out;
+};
+
 // run (its sweep options, --manifest/--job/--shard, come from StudyCommands)
 struct RunVerb : Pinned {
   explicit RunVerb(CLI::App& app) {
@@ -376,6 +403,7 @@ int driftlab_main(int argc, char** argv) {
   app.require_subcommand(1);
 
   const ScenarioVerbs scenario_verbs(app);
+  const MetricsVerbs metrics_verbs(app);
   const RunVerb run_verb(app);
   const RenderVerb render_verb(app);
   const EvalVerb eval_verb(app);
@@ -396,6 +424,7 @@ int driftlab_main(int argc, char** argv) {
 
   return driftlab::app::run_cli_main(app, argc, argv, [&]() -> int {
     if (const auto rc = scenario_verbs.dispatch()) return *rc;
+    if (const auto rc = metrics_verbs.dispatch()) return *rc;
     if (const auto rc = study_commands.dispatch()) return *rc;
     if (const auto rc = dataset_commands.dispatch()) return *rc;
     if (const auto rc = image_stats_command.dispatch()) return *rc;

@@ -5,7 +5,6 @@
 #include <array>
 #include <filesystem>
 #include <iostream>
-#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "app/cli_main.hpp"
@@ -15,6 +14,7 @@
 #include "eval/evaluate.hpp"
 #include "gate/gate.hpp"
 #include "pipeline/scenario.hpp"
+#include "record/run_record.hpp"
 #include "report/basin_paper_compare.hpp"
 #include "report/paper_compare.hpp"
 
@@ -37,13 +37,13 @@ std::array<double, 3> prism_point(const std::string& text) {
 // them (its eval options and its frames.csv covariates), added to `metrics` as
 // algorithms."NAME (prism)".
 void add_prism_columns(const fs::path& run_dir, const std::array<double, 3>& prism,
-                       nlohmann::json* metrics) {
+                       record::RunRecord* metrics) {
   const pipeline::Scenario sc = pipeline::load_scenario(run_dir / "scenario.resolved.yaml");
   const Trajectory gt = read_trajectory(run_dir / "groundtruth.tum", TrajectoryFormat::kTum);
   const fs::path frames_path = run_dir / "frames.csv";
   const eval::FrameTable frames = eval::read_frame_table(frames_path.string());
   for (const char* a : {"sparse", "sparse_kf", "dense"}) {
-    if (!(*metrics)["algorithms"].contains(a)) continue;
+    if (!metrics->algorithms.count(a)) continue;
     eval::EvaluationInput in;
     in.gt = gt;
     in.est =
@@ -52,8 +52,8 @@ void add_prism_columns(const fs::path& run_dir, const std::array<double, 3>& pri
     in.options = sc.eval;
     in.options.reference_point_m = prism;
     in.frames = eval::run_vo_covariates(frames, a, frames_path.string());
-    (*metrics)["algorithms"][std::string(a) + " (prism)"] =
-        eval::to_json(eval::evaluate(in), in.options);
+    metrics->algorithms[std::string(a) + " (prism)"].evaluation =
+        eval::evaluation_record(eval::evaluate(in), in.options);
   }
 }
 
@@ -61,13 +61,13 @@ void add_prism_columns(const fs::path& run_dir, const std::array<double, 3>& pri
 
 int paper_command(const std::vector<std::string>& runs, const std::string& track_name,
                   const std::string& prism, const std::string& out) {
-  std::vector<nlohmann::json> all;
+  std::vector<record::RunRecord> all;
   std::vector<fs::path> files;
   for (const std::string& r : runs) {
     files.push_back(gate::find_results_metrics(r));
-    all.push_back(gate::read_results_metrics(files.back()));
+    all.push_back(record::read_run_record(files.back()));
   }
-  if (report::basin_paper_experiment_of(all.front().value("scenario", std::string()))) {
+  if (report::basin_paper_experiment_of(all.front().scenario.value_or(""))) {
     if (!track_name.empty()) throw UsageError("--track: the basin paper has no tracks to choose");
     write_or_print(report::basin_paper_side_by_side(all), out);
     return kExitOk;
@@ -81,8 +81,8 @@ int paper_command(const std::vector<std::string>& runs, const std::string& track
   if (track_name == "total") track = report::RiverPaperTrack::kTotal;
   if (!track_name.empty() && !track)
     throw UsageError(fmt::format("--track: got '{}', expected discharge or total", track_name));
-  nlohmann::json& metrics = all.front();
-  const std::string scenario = metrics.value("scenario", std::string());
+  record::RunRecord& metrics = all.front();
+  const std::string scenario = metrics.scenario.value_or("");
   if (!track) track = report::river_paper_track_of(scenario);
   if (!track)
     throw UsageError(fmt::format(
@@ -90,9 +90,10 @@ int paper_command(const std::vector<std::string>& runs, const std::string& track
         "say which row of its Table 2 to compare with: --track discharge|total",
         runs.front(), scenario));
   // A run already measured at a prism (eval.reference_point_m) has no camera columns to add to.
-  const nlohmann::json::json_pointer own("/algorithms/sparse/association/reference_point_m");
-  const bool at_camera = !metrics.contains(own) ||
-                         metrics.at(own) == nlohmann::json(std::vector<double>{0.0, 0.0, 0.0});
+  const auto sparse = metrics.algorithms.find("sparse");
+  const bool at_camera =
+      sparse == metrics.algorithms.end() ||
+      sparse->second.evaluation.association.reference_point_m == std::array<double, 3>{0, 0, 0};
   const fs::path dir = files.front().parent_path();
   if (prism != "none" && at_camera) {
     const std::array<double, 3> point = prism_point(prism);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/record_json.hpp"
 #include "core/rotation.hpp"
 #include "core/yaml_io.hpp"
 
@@ -223,185 +224,119 @@ std::string Evaluation::brief() const {
 
 namespace {
 
-class JsonBuilder {
- public:
-  explicit JsonBuilder(std::vector<std::string>* warnings) : warnings_(warnings) {}
+ErrorStats error_stats(const Summary& s) {
+  return {s.n, s.min, s.max, s.mean, s.median, s.rmse, s.std_population};
+}
 
-  nlohmann::json number(double v, const std::string& key) {
-    if (std::isfinite(v)) return v;
-    warnings_->push_back(
-        fmt::format("{} is not finite ({}); written as null", key, yaml::format_double(v)));
-    return nullptr;
+SampleStats sample_stats(const Summary& s) {
+  return {s.n, s.min, s.max, s.mean, s.median, s.rmse, s.sd_sample};
+}
+
+TrackRecord track_record(const TrackErrors& t) {
+  return {t.n,          t.rmse_3d_m,   t.max_3d_m,     t.rmse_2d_m,
+          t.max_2d_m,   t.rmse_3d_pct, t.max_3d_pct,   t.rmse_2d_pct,
+          t.max_2d_pct, t.length_gt_m, t.length_est_m, t.length_error_pct};
+}
+
+Table1Rows table1_rows(const SectionSummary& ss) {
+  return {sample_stats(ss.p_m_per_m),      sample_stats(ss.x_m_per_m),
+          sample_stats(ss.y_m_per_m),      sample_stats(ss.z_m_per_m),
+          sample_stats(ss.roll_deg_per_m), sample_stats(ss.pitch_deg_per_m),
+          sample_stats(ss.yaw_deg_per_m)};
+}
+
+BasinRows basin_rows(const BasinTable& t) {
+  const auto row = [](const Summary& s) { return BasinRow{s.rmse, s.sd_sample, s.n}; };
+  return {row(t.north_m), row(t.east_m), row(t.surge_m_s), row(t.sway_m_s), row(t.heading_deg)};
+}
+
+RegressionRecord regression_record(const Evaluation& e) {
+  RegressionRecord r;
+  if (!e.regression) {
+    r.skipped = e.regression_skipped;
+    return r;
   }
+  const OlsResult& ols = *e.regression;
+  r.n = ols.n;
+  r.r2 = ols.r2;
+  r.adj_r2 = ols.adj_r2;
+  r.f = ols.f;
+  r.f_p = ols.f_p;
+  r.sigma = ols.sigma;
+  r.coefficients.emplace();
+  for (const auto& c : ols.coefficients)
+    (*r.coefficients)[c.name] = {c.estimate, c.std_error, c.t, c.p, c.vif, c.significant};
+  const OlsDiagnostics& d = ols.diagnostics;
+  r.diagnostics =
+      DiagnosticsRecord{d.jarque_bera,      d.jarque_bera_p,   d.shapiro_wilk_w, d.shapiro_wilk_p,
+                        d.breusch_pagan_lm, d.breusch_pagan_p, d.durbin_watson,  d.max_vif};
+  r.warnings = ols.warnings;
+  return r;
+}
 
-  nlohmann::json summary(const Summary& s, const std::string& key, bool sample_sd) {
-    nlohmann::json j;
-    j["n"] = s.n;
-    j["min"] = number(s.min, key + ".min");
-    j["max"] = number(s.max, key + ".max");
-    j["mean"] = number(s.mean, key + ".mean");
-    j["median"] = number(s.median, key + ".median");
-    j["rmse"] = number(s.rmse, key + ".rmse");
-    if (sample_sd) {
-      j["sd"] = number(s.sd_sample, key + ".sd");
-    } else {
-      j["std"] = number(s.std_population, key + ".std");
-    }
-    return j;
-  }
-
-  nlohmann::json track(const TrackErrors& t, const std::string& key) {
-    nlohmann::json j;
-    j["n"] = t.n;
-    j["rmse_3d_m"] = number(t.rmse_3d_m, key + ".rmse_3d_m");
-    j["max_3d_m"] = number(t.max_3d_m, key + ".max_3d_m");
-    j["rmse_2d_m"] = number(t.rmse_2d_m, key + ".rmse_2d_m");
-    j["max_2d_m"] = number(t.max_2d_m, key + ".max_2d_m");
-    j["rmse_3d_pct"] = number(t.rmse_3d_pct, key + ".rmse_3d_pct");
-    j["max_3d_pct"] = number(t.max_3d_pct, key + ".max_3d_pct");
-    j["rmse_2d_pct"] = number(t.rmse_2d_pct, key + ".rmse_2d_pct");
-    j["max_2d_pct"] = number(t.max_2d_pct, key + ".max_2d_pct");
-    j["length_gt_m"] = number(t.length_gt_m, key + ".length_gt_m");
-    j["length_est_m"] = number(t.length_est_m, key + ".length_est_m");
-    j["length_error_pct"] = number(t.length_error_pct, key + ".length_error_pct");
-    return j;
-  }
-
- private:
-  std::vector<std::string>* warnings_;
-};
-
-}  // namespace
-
-nlohmann::json to_json(const Evaluation& e, const EvalOptions& options) {
-  std::vector<std::string> warnings = e.warnings;
-  JsonBuilder b(&warnings);
-  nlohmann::json j;
-  j["algorithm"] = e.algorithm;
-  j["association"] = {{"pairs", e.association.size()},
-                      {"gt_poses", e.gt_poses},
-                      {"est_poses", e.est_poses},
-                      {"max_diff_s", options.association_tolerance_s},
-                      {"reference_point_m", options.reference_point_m}};
-  nlohmann::json R = nlohmann::json::array();
-  for (int r = 0; r < 3; ++r)
-    R.push_back({e.alignment.R(r, 0), e.alignment.R(r, 1), e.alignment.R(r, 2)});
-  j["alignment"] = {{"method", std::string(yaml::enum_name(options.align))},
-                    {"first_n", options.align_first_n},
-                    {"rotation", R},
-                    {"translation_m", {e.alignment.t.x(), e.alignment.t.y(), e.alignment.t.z()}},
-                    {"scale", e.alignment.scale}};
-  j["ape"]["trans_m"] = b.summary(e.ape.trans_m, "ape.trans_m", false);
-  j["ape"]["rot_deg"] = b.summary(e.ape.rot_deg, "ape.rot_deg", false);
-  j["rpe"] = {{"delta", options.rpe_delta},
-              {"unit", std::string(yaml::enum_name(options.rpe_unit))},
-              {"pairs", e.rpe.pairs}};
-  j["rpe"]["trans_m"] = b.summary(e.rpe.trans_m, "rpe.trans_m", false);
-  j["rpe"]["rot_deg"] = b.summary(e.rpe.rot_deg, "rpe.rot_deg", false);
-  j["track"] = b.track(e.track, "track");
-  j["subtracks"] = nlohmann::json::object();
-  for (const auto& s : e.subtracks)
-    j["subtracks"][s.name] = b.track(s.track, "subtracks." + s.name);
-
-  // Table 1's rows into `out`; a non-finite value is named PREFIX.KEY in the warnings.
-  const auto table1 = [&](const SectionSummary& ss, const std::string& prefix,
-                          nlohmann::json& out) {
-    const std::pair<const char*, const Summary*> rows[] = {
-        {"p_m_per_m", &ss.p_m_per_m},           {"x_m_per_m", &ss.x_m_per_m},
-        {"y_m_per_m", &ss.y_m_per_m},           {"z_m_per_m", &ss.z_m_per_m},
-        {"roll_deg_per_m", &ss.roll_deg_per_m}, {"pitch_deg_per_m", &ss.pitch_deg_per_m},
-        {"yaw_deg_per_m", &ss.yaw_deg_per_m}};
-    for (const auto& [key, summary] : rows) out[key] = b.summary(*summary, prefix + key, true);
-  };
-  j["sections"] = {{"section_length_m", options.section_length_m}, {"count", e.sections.size()}};
-  table1(e.section_summary, "sections.", j["sections"]);
+void add_sections(const Evaluation& e, const EvalOptions& options, EvaluationRecord* r) {
+  r->sections.section_length_m = options.section_length_m;
+  r->sections.count = e.sections.size();
+  r->sections.rows = table1_rows(e.section_summary);
   if (e.tracked_summary) {
-    j["sections"]["with_lost_track"] = e.lost_track_sections;
-    nlohmann::json tracked = {{"count", e.sections.size() - e.lost_track_sections.size()}};
-    table1(*e.tracked_summary, "sections.tracked.", tracked);
-    j["sections"]["tracked"] = tracked;
+    r->sections.with_lost_track = e.lost_track_sections;
+    r->sections.tracked = TrackedSections{e.sections.size() - e.lost_track_sections.size(),
+                                          table1_rows(*e.tracked_summary)};
   }
   if (e.paper_attitude) {
     const PaperAttitude& a = *e.paper_attitude;
-    j["paper_attitude"] = {
-        {"reference", "ahrs"},
-        {"pairs", a.pairs},
-        {"roll_deg_per_m", b.summary(a.roll_deg_per_m, "paper_attitude.roll_deg_per_m", true)},
-        {"pitch_deg_per_m", b.summary(a.pitch_deg_per_m, "paper_attitude.pitch_deg_per_m", true)},
-        {"yaw_deg_per_m", b.summary(a.yaw_deg_per_m, "paper_attitude.yaw_deg_per_m", true)},
-        {"max_abs_deg",
-         {{"roll", rad2deg(a.max_abs_rad.roll_rad)},
-          {"pitch", rad2deg(a.max_abs_rad.pitch_rad)},
-          {"yaw", rad2deg(a.max_abs_rad.yaw_rad)}}}};
+    r->paper_attitude =
+        PaperAttitudeRecord{"ahrs",
+                            a.pairs,
+                            sample_stats(a.roll_deg_per_m),
+                            sample_stats(a.pitch_deg_per_m),
+                            sample_stats(a.yaw_deg_per_m),
+                            {rad2deg(a.max_abs_rad.roll_rad), rad2deg(a.max_abs_rad.pitch_rad),
+                             rad2deg(a.max_abs_rad.yaw_rad)}};
   }
-  j["covariates"] = nlohmann::json::object();
-  for (const auto& [name, summary] : e.covariates)
-    j["covariates"][name] = b.summary(summary, "covariates." + name, true);
+  for (const auto& [name, summary] : e.covariates) r->covariates[name] = sample_stats(summary);
+  r->regression = regression_record(e);
+}
 
-  if (e.regression) {
-    const OlsResult& r = *e.regression;
-    nlohmann::json reg;
-    reg["n"] = r.n;
-    reg["r2"] = b.number(r.r2, "regression.r2");
-    reg["adj_r2"] = b.number(r.adj_r2, "regression.adj_r2");
-    reg["f"] = b.number(r.f, "regression.f");
-    reg["f_p"] = b.number(r.f_p, "regression.f_p");
-    reg["sigma"] = b.number(r.sigma, "regression.sigma");
-    for (const auto& c : r.coefficients) {
-      const std::string key = "regression.coefficients." + c.name;
-      reg["coefficients"][c.name] = {{"estimate", b.number(c.estimate, key + ".estimate")},
-                                     {"std_error", b.number(c.std_error, key + ".std_error")},
-                                     {"t", b.number(c.t, key + ".t")},
-                                     {"p", b.number(c.p, key + ".p")},
-                                     {"vif", b.number(c.vif, key + ".vif")},
-                                     {"significant", c.significant}};
-    }
-    const OlsDiagnostics& d = r.diagnostics;
-    reg["diagnostics"] = {
-        {"jarque_bera", b.number(d.jarque_bera, "regression.diagnostics.jarque_bera")},
-        {"jarque_bera_p", b.number(d.jarque_bera_p, "regression.diagnostics.jarque_bera_p")},
-        {"shapiro_wilk_w", b.number(d.shapiro_wilk_w, "regression.diagnostics.shapiro_wilk_w")},
-        {"shapiro_wilk_p", b.number(d.shapiro_wilk_p, "regression.diagnostics.shapiro_wilk_p")},
-        {"breusch_pagan_lm",
-         b.number(d.breusch_pagan_lm, "regression.diagnostics.breusch_pagan_lm")},
-        {"breusch_pagan_p", b.number(d.breusch_pagan_p, "regression.diagnostics.breusch_pagan_p")},
-        {"durbin_watson", b.number(d.durbin_watson, "regression.diagnostics.durbin_watson")},
-        {"max_vif", b.number(d.max_vif, "regression.diagnostics.max_vif")}};
-    reg["warnings"] = r.warnings;
-    j["regression"] = reg;
-  } else {
-    j["regression"] = {{"skipped", e.regression_skipped}};
-  }
+}  // namespace
 
-  auto basin_row = [&](const Summary& s, const std::string& key) {
-    return nlohmann::json{{"rmse", b.number(s.rmse, key + ".rmse")},
-                          {"sd", b.number(s.sd_sample, key + ".sd")},
-                          {"n", s.n}};
-  };
-  auto basin_json = [&](const BasinTable& t, const std::string& key) {
-    return nlohmann::json{{"north_m", basin_row(t.north_m, key + ".north_m")},
-                          {"east_m", basin_row(t.east_m, key + ".east_m")},
-                          {"surge_m_s", basin_row(t.surge_m_s, key + ".surge_m_s")},
-                          {"sway_m_s", basin_row(t.sway_m_s, key + ".sway_m_s")},
-                          {"heading_deg", basin_row(t.heading_deg, key + ".heading_deg")}};
-  };
-  j["basin"] = basin_json(e.basin, "basin");
-  if (e.basin_reference) {
-    j["basin_overhead"] = basin_json(*e.basin_reference, "basin_overhead");
-    j["basin_overhead"]["reference"] = e.basin_reference_name;
-    j["basin_overhead"]["pairs"] = e.basin_reference_pairs;
-  }
-  j["kitti"] = nlohmann::json::array();
-  for (const auto& k : e.kitti) {
-    const std::string key = fmt::format("kitti[{}]", k.length_m);
-    j["kitti"].push_back({{"length_m", k.length_m},
-                          {"count", k.count},
-                          {"trans_err_pct", b.number(k.trans_err_pct, key + ".trans_err_pct")},
-                          {"rot_err_deg_per_100m",
-                           b.number(k.rot_err_deg_per_100m, key + ".rot_err_deg_per_100m")}});
-  }
-  j["warnings"] = warnings;
-  return j;
+EvaluationRecord evaluation_record(const Evaluation& e, const EvalOptions& options) {
+  EvaluationRecord r;
+  r.algorithm = e.algorithm;
+  r.association = {e.association.size(), e.gt_poses, e.est_poses, options.association_tolerance_s,
+                   options.reference_point_m};
+  r.alignment.method = std::string(yaml::enum_name(options.align));
+  r.alignment.first_n = options.align_first_n;
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) r.alignment.rotation[i][k] = e.alignment.R(i, k);
+  r.alignment.translation_m = {e.alignment.t.x(), e.alignment.t.y(), e.alignment.t.z()};
+  r.alignment.scale = e.alignment.scale;
+  r.ape = {error_stats(e.ape.trans_m), error_stats(e.ape.rot_deg)};
+  r.rpe = {options.rpe_delta,
+           std::string(yaml::enum_name(options.rpe_unit)),
+           e.rpe.pairs,
+           {error_stats(e.rpe.trans_m), error_stats(e.rpe.rot_deg)}};
+  r.track = track_record(e.track);
+  for (const auto& s : e.subtracks) r.subtracks[s.name] = track_record(s.track);
+  add_sections(e, options, &r);
+  r.basin = basin_rows(e.basin);
+  if (e.basin_reference)
+    r.basin_overhead = BasinReferenceRecord{basin_rows(*e.basin_reference), e.basin_reference_name,
+                                            e.basin_reference_pairs};
+  for (const auto& k : e.kitti)
+    r.kitti.push_back({k.length_m, k.count, k.trans_err_pct, k.rot_err_deg_per_100m});
+  r.warnings = e.warnings;
+  // A number that is not finite is written as null; the warnings name each one.
+  std::vector<record_json::NonFinite> nonfinite;
+  record_json::to_json(r, &nonfinite);
+  for (const auto& [key, value] : nonfinite)
+    r.warnings.push_back(
+        fmt::format("{} is not finite ({}); written as null", key, yaml::format_double(value)));
+  return r;
+}
+
+nlohmann::json to_json(const Evaluation& e, const EvalOptions& options) {
+  return record_json::to_json(evaluation_record(e, options));
 }
 
 // ---------------------------------------------------------------------------

@@ -16,6 +16,7 @@
 #include "eval/ape_rpe.hpp"
 #include "eval/association.hpp"
 #include "eval/eval_options.hpp"
+#include "eval/evaluation_record.hpp"
 #include "eval/kitti_segments.hpp"
 #include "eval/paper_attitude.hpp"
 #include "eval/regression.hpp"
@@ -84,8 +85,12 @@ struct Evaluation {
 /// covariates) are recorded in `regression_skipped` / `warnings` instead.
 Evaluation evaluate(const EvaluationInput& input);
 
-/// metrics.json content. Never contains NaN or Inf (such a value becomes null
-/// and a warning names it).
+/// The evaluation as metrics.json reports it; its warnings name each number that is not
+/// finite (written as null).
+EvaluationRecord evaluation_record(const Evaluation& e, const EvalOptions& options);
+
+/// metrics.json content: evaluation_record() written. Never contains NaN or Inf (such a value
+/// becomes null and a warning names it).
 nlohmann::json to_json(const Evaluation& e, const EvalOptions& options);
 
 /// sections.csv: one row per section with errors, per-metre errors and covariates.

@@ -63,7 +63,6 @@ struct LevelledWorld {
   Mat3 R_N_W = Mat3::Identity();
   std::string down_axis = "+z";
   double tilt_deg = 0;  // between gravity and that axis
-  nlohmann::json to_json() const { return {{"down_axis", down_axis}, {"tilt_deg", tilt_deg}}; }
 };
 
 LevelledWorld level_world(const std::vector<ImuSample>& imu, const SE3& T_W_S0, TimeNs t0) {
@@ -269,7 +268,7 @@ std::vector<std::string> evaluate_tracks(const dataset::StereoDataset& d, const 
     in.options = settings.eval;
     in.frames = covariates(t.vo ? t : tracks[t.source], used);
     const eval::Evaluation e = eval::evaluate(in);
-    records->algorithms[t.name].evaluation = eval::to_json(e, settings.eval);
+    records->algorithms[t.name].evaluation = eval::evaluation_record(e, settings.eval);
     tables += eval::tables_markdown(e, settings.eval) + "\n";
     const std::string csv = eval::sections_csv(e);
     sections += sections.empty() ? csv : csv.substr(csv.find('\n') + 1);
@@ -283,33 +282,35 @@ std::vector<std::string> evaluate_tracks(const dataset::StereoDataset& d, const 
   return briefs;
 }
 
-nlohmann::json dataset_record(const dataset::StereoDataset& d, std::size_t used,
-                              std::size_t first) {
-  return {{"root", d.root.string()},
-          {"format", dataset::format_name(d.format)},
-          {"frames_used", used},
-          {"first_frame", first},
-          {"ground_truth", !d.camera_gt.empty()},
-          {"imu_samples", d.imu.size()},
-          {"compass_samples", d.compass.size()},
-          {"fx_px", d.rig.camera.fx},
-          {"baseline_m", d.rig.baseline_m},
-          {"width_px", d.rig.camera.width},
-          {"height_px", d.rig.camera.height}};
+record::DatasetRecord dataset_record(const dataset::StereoDataset& d, std::size_t used,
+                                     std::size_t first) {
+  record::DatasetRecord r;
+  r.root = d.root.string();
+  r.format = dataset::format_name(d.format);
+  r.frames_used = used;
+  r.first_frame = first;
+  r.ground_truth = !d.camera_gt.empty();
+  r.imu_samples = d.imu.size();
+  r.compass_samples = d.compass.size();
+  r.fx_px = d.rig.camera.fx;
+  r.baseline_m = d.rig.baseline_m;
+  r.width_px = d.rig.camera.width;
+  r.height_px = d.rig.camera.height;
+  return r;
 }
 
 }  // namespace
 
-nlohmann::json DatasetRunSummary::to_json() const {
-  nlohmann::json m;
-  m["version"] = DRIFTLAB_VERSION;
-  m["seed"] = seed;
-  m["dataset"] = dataset;
-  if (filters_world) m["filters_world"] = *filters_world;
-  tracks.add_to(&m);
-  m["timing"]["total_s"] = total_s;
-  m["warnings"] = warnings;
-  return m;
+record::RunRecord DatasetRunSummary::run_record() const {
+  record::RunRecord r;
+  r.version = DRIFTLAB_VERSION;
+  r.seed = seed;
+  r.dataset = dataset;
+  r.filters_world = filters_world;
+  tracks.add_to(&r);
+  r.timing.total_s = total_s;
+  r.warnings = warnings;
+  return r;
 }
 
 std::string DatasetRunSummary::brief() const {
@@ -337,7 +338,7 @@ DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario
   });
   if (gravity && !d.imu.empty() && !used.empty()) {
     world = level_world(d.imu, T_W_C0 * d.T_S_C.inverse(), used.front().t_ns);
-    summary.filters_world = world.to_json();
+    summary.filters_world = record::FiltersWorldRecord{world.down_axis, world.tilt_deg};
     if (world.tilt_deg > 2.0)
       summary.warnings.push_back(fmt::format(
           "the dataset's world is tilted {:.1f} deg from gravity; the filters take {} as down",
@@ -358,7 +359,7 @@ DatasetRunSummary run_on_dataset(const dataset::StereoDataset& d, const Scenario
   summary.algorithms =
       evaluate_tracks(d, settings, tracks, used, dir.path(), &summary.tracks, &summary.warnings);
   summary.total_s = seconds_since(t0);
-  write_file_atomic(dir.path() / "metrics.json", summary.to_json().dump(2) + "\n");
+  write_file_atomic(dir.path() / "metrics.json", record::metrics_text(summary.run_record()));
   dir.commit();
   return summary;
 }

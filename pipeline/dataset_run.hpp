@@ -27,18 +27,18 @@ struct DatasetRunOptions {
   bool progress_tty = false;
 };
 
-/// What `driftlab vo` measured: one typed record, written to metrics.json by to_json().
+/// What `driftlab vo` measured, turned into metrics.json's record by run_record().
 struct DatasetRunSummary {
   std::uint64_t seed = 0;
   std::size_t frames = 0;
   double total_s = 0;
-  nlohmann::json dataset;                       ///< the dataset: root, format, frames, rig
-  std::optional<nlohmann::json> filters_world;  ///< the filters' levelled world, when used
+  record::DatasetRecord dataset;  ///< the dataset: root, format, frames, rig
+  std::optional<record::FiltersWorldRecord> filters_world;  ///< the filters' levelled world
   TrackRecords tracks;
   std::vector<std::string> algorithms;  ///< one brief line per estimate (VO or filter)
   std::vector<std::string> warnings;
   std::string brief() const;
-  nlohmann::json to_json() const;
+  record::RunRecord run_record() const;
 };
 
 /// Runs the VOs on `data` into `out_dir` (written atomically): estimates/NAME.tum,

@@ -224,29 +224,28 @@ std::vector<ExternalVoResult> ExternalVoStage::finish(
     const Stopwatch watch;
     const ExitStatus status =
         run_with_timeout(command, e->options.timeout_s, e->folder / "log.txt");
-    r.record = {{"command", command},
-                {"format", dataset::format_name(e->options.format)},
-                {"output", format_name(e->options.output)},
-                {"exit", status.describe()},
-                {"seconds", watch.ms() / 1000},
-                {"frames", e->stamps.size()}};
+    r.record.format = dataset::format_name(e->options.format);
+    r.record.output = format_name(e->options.output);
+    r.record.exit = status.describe();
+    r.record.seconds = watch.ms() / 1000;
+    r.record.frames = e->stamps.size();
     // timeout exits 124 when its TERM ended the command; a command that ignores TERM is
     // killed 5 s later together with timeout itself (its whole process group).
     const bool killed_at_limit =
         !status.exited && status.signal == SIGKILL && watch.ms() / 1000 >= e->options.timeout_s;
     if ((status.exited && status.code == 124) || killed_at_limit) {
-      r.record["status"] = "timeout";
+      r.record.status = "timeout";
       r.warning = fmt::format("external VO '{}': no result within timeout_s = {} s", r.name,
                               e->options.timeout_s);
     } else if (!status.ok()) {
-      r.record["status"] = "failed";
+      r.record.status = "failed";
       r.warning =
           fmt::format("external VO '{}': the command failed ({})", r.name, status.describe());
     } else {
       try {
         r.estimate = e->read_estimate();
         r.ok = true;
-        r.record["status"] = "ok";
+        r.record.status = "ok";
         const auto angle = heading_disagreement_deg(r.estimate, e->truth, 1.0);
         if (angle && *angle > 45)
           r.warning = fmt::format(
@@ -254,7 +253,7 @@ std::vector<ExternalVoResult> ExternalVoStage::finish(
               "camera's; is {} a left-camera trajectory (x right, y down, z forward)?",
               r.name, *angle, e->out().filename().string());
       } catch (const UserError& err) {
-        r.record["status"] = "bad output";
+        r.record.status = "bad output";
         r.warning =
             fmt::format("external VO '{}': its trajectory cannot be read: {}", r.name, err.what());
       }
@@ -268,9 +267,9 @@ std::vector<ExternalVoResult> ExternalVoStage::finish(
       return text;
     };
     r.warning = reported(r.warning);
-    r.record["command"] = reported(command);
-    r.record["message"] = r.warning;
-    r.record["log_tail"] = reported(log_tail(e->folder / "log.txt"));
+    r.record.command = reported(command);
+    r.record.message = r.warning;
+    r.record.log_tail = reported(log_tail(e->folder / "log.txt"));
     if (!e->options.keep_dataset) fs::remove_all(e->root);
     results.push_back(std::move(r));
   }

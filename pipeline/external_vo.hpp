@@ -19,6 +19,7 @@
 #include "core/trajectory_io.hpp"
 #include "dataset/dataset.hpp"
 #include "pipeline/scenario.hpp"
+#include "record/run_record.hpp"
 #include "sim/render/renderer.hpp"
 
 namespace driftlab::pipeline {
@@ -27,9 +28,9 @@ namespace driftlab::pipeline {
 struct ExternalVoResult {
   std::string name;
   bool ok = false;
-  Trajectory estimate;    ///< left camera, anchored at the true first pose; empty unless ok
-  nlohmann::json record;  ///< status, command, exit, seconds, message, log_tail
-  std::string warning;    ///< why it failed, or why the estimate looks wrong; empty if neither
+  Trajectory estimate;  ///< left camera, anchored at the true first pose; empty unless ok
+  record::ExternalVoRecord record;  ///< status, command, exit, seconds, message, log_tail
+  std::string warning;  ///< why it failed, or why the estimate looks wrong; empty if neither
 };
 
 class ExternalVoStage {

@@ -167,7 +167,6 @@ FilterCounts FilterTrack::counts() const {
   const fusion::FilterSummary s = filter_->summary();
   FilterCounts c;
   c.nonfinite_guards = s.nonfinite_guards;
-  c.counts = nlohmann::ordered_json::object();
   for (const auto& [name, value] : s.counts) c.counts[name] = value;
   return c;
 }

@@ -8,8 +8,8 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "core/rng.hpp"
@@ -26,7 +26,7 @@ namespace driftlab::pipeline {
 /// never expected, so each one is a warning).
 struct FilterCounts {
   std::int64_t nonfinite_guards = 0;
-  nlohmann::ordered_json counts;  // every counter of the filter, nonfinite_guards included
+  std::map<std::string, std::int64_t> counts;  // every counter, nonfinite_guards included
 };
 
 /// Where the sensors sit on the body frame B (the frame whose pose is the anchor, and the NED

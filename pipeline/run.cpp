@@ -77,34 +77,24 @@ std::string RunSummary::brief() const {
   return s + fmt::format(", total {:.2f} s", total_s);
 }
 
-nlohmann::json RunSummary::to_json() const {
-  nlohmann::json m;
-  m["version"] = DRIFTLAB_VERSION;
-  m["seed"] = seed;
-  m["scenario"] = scenario;
-  m["frames"] = frames;
-  m["track"]["length_m"] = track_length_m;
-  m["motion"] = {{"mission_completed", motion.mission_completed},
-                 {"duration_s", motion.duration_s},
-                 {"distance_m", motion.distance_m},
-                 {"mean_speed_m_s", motion.mean_speed_mps},
-                 {"physics_steps", motion.steps}};
-  m["stages"] = {{"scenario", stages.scenario},
-                 {"physics", stages.physics},
-                 {"sensors", stages.sensors},
-                 {"render", stages.render},
-                 {"vo", stages.vo},
-                 {"external_vo", stages.external_vo},
-                 {"fusion", stages.fusion},
-                 {"eval", stages.eval}};
-  m["sensors"] = sensors;
-  m["timing"]["sensors_s"] = sensors_s;
-  m["timing"]["physics_s"] = physics_s;
-  m["timing"]["total_s"] = total_s;
-  m["timing"]["physics_steps_per_s"] =
+record::RunRecord RunSummary::run_record() const {
+  record::RunRecord r;
+  r.version = DRIFTLAB_VERSION;
+  r.seed = seed;
+  r.scenario = scenario;
+  r.frames = frames;
+  r.track = record::TrackLengthRecord{track_length_m};
+  r.motion = record::MotionRecord{motion.mission_completed, motion.duration_s, motion.distance_m,
+                                  motion.mean_speed_mps, motion.steps};
+  r.stages = stages;
+  if (sensors.imu || sensors.ahrs || sensors.gps || sensors.compass) r.sensors = sensors;
+  r.timing.sensors_s = sensors_s;
+  r.timing.physics_s = physics_s;
+  r.timing.total_s = total_s;
+  r.timing.physics_steps_per_s =
       physics_s > 0 ? static_cast<double>(motion.steps) / physics_s : 0.0;
-  if (vision) vision->add_to(&m);
-  return m;
+  if (vision) vision->add_to(&r);
+  return r;
 }
 
 SE3 camera_mount_T_B_C(const sim::MountOptions& mount) {
@@ -211,7 +201,7 @@ std::string report_tracking(const std::vector<Track>& tracks, const Trajectory& 
   for (const Track& tr : tracks) {
     if (!tr.vo) continue;
     const TrackingSummary s = summarize_tracking(tr.results, camera_gt);
-    records->algorithms[tr.name].tracking = s.to_json();
+    records->algorithms[tr.name].tracking = s.tracking_record();
     const std::string w = tracking_warning(tr.name, s);
     if (!w.empty()) warnings->push_back(w);
     names.push_back(tr.name);
@@ -297,7 +287,7 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
     }
     in.frames = ft;
     const eval::Evaluation e = eval::evaluate(in);
-    records->algorithms[tr.name].evaluation = eval::to_json(e, sc.eval);
+    records->algorithms[tr.name].evaluation = eval::evaluation_record(e, sc.eval);
     report += eval::tables_markdown(e, sc.eval) + "\n";
     const std::string csv = eval::sections_csv(e);
     sections += sections.empty() ? csv : csv.substr(csv.find('\n') + 1);
@@ -313,7 +303,7 @@ std::string evaluate_tracks(const Scenario& sc, const std::vector<Track>& tracks
 void write_report(const Scenario& sc, const std::vector<Track>& tracks, const Trajectory& camera_gt,
                   const std::filesystem::path& dir, std::size_t sample_frame,
                   const std::string& sections, std::string report,
-                  const std::map<std::string, nlohmann::json>& external_vo,
+                  const std::map<std::string, ExternalVoRecord>& external_vo,
                   std::vector<std::string>* warnings) {
   std::vector<report::NamedTrajectory> named;
   for (const auto& tr : tracks) named.push_back({tr.name, tr.estimate});
@@ -331,9 +321,8 @@ void write_report(const Scenario& sc, const std::vector<Track>& tracks, const Tr
     report +=
         "## External VOs\n\n| name | status | exit | seconds | message |\n|---|---|---|---|---|\n";
     for (const auto& [name, r] : external_vo)
-      report += fmt::format("| {} | {} | {} | {:.2f} | {} |\n", name,
-                            r["status"].get<std::string>(), r["exit"].get<std::string>(),
-                            r["seconds"].get<double>(), r["message"].get<std::string>());
+      report += fmt::format("| {} | {} | {} | {:.2f} | {} |\n", name, r.status, r.exit, r.seconds,
+                            r.message);
     report += "\nEach command's output is in external/NAME/log.txt.\n\n";
   }
   const std::string tables = report;
@@ -445,7 +434,7 @@ double run_frame_loop(const FrameLoop& loop) {
 void add_whole_run_tracks(const Scenario& sc, const std::vector<sim::SampleTime>& stamps,
                           std::size_t first, const MissionTruth& mission, ExternalVoStage* external,
                           std::vector<Track>* tracks,
-                          std::map<std::string, nlohmann::json>* external_vo,
+                          std::map<std::string, ExternalVoRecord>* external_vo,
                           std::vector<std::string>* warnings) {
   if (runs_backward_pass(sc.pipeline)) {
     std::vector<std::optional<TimeNs>> delivered(stamps.size());
@@ -612,7 +601,7 @@ MissionTruth simulate_mission(const Scenario& sc,
 }
 
 // What each stage did, with the reason when it did not run.
-static StageRecord stages_record(const Scenario& sc, const RunOptions& options, bool ran_vision) {
+static StagesRecord stages_record(const Scenario& sc, const RunOptions& options, bool ran_vision) {
   const auto& s = sc.sensors;
   const std::string vision = ran_vision            ? "done"
                              : options.only_motion ? "skipped (--only-motion)"
@@ -621,7 +610,7 @@ static StageRecord stages_record(const Scenario& sc, const RunOptions& options, 
   const auto unless = [&](bool empty, const char* why) {
     return vision != "done" ? vision : empty ? std::string("skipped (") + why + ")" : vision;
   };
-  StageRecord r;
+  StagesRecord r;
   r.scenario = "done";
   r.physics = "done";
   r.sensors = s.imu.enabled || s.gps.enabled || s.compass.enabled
@@ -682,7 +671,7 @@ RunSummary run_scenario(const Scenario& sc, const std::filesystem::path& out_dir
   summary.seed = sc.seed;
   summary.stages = stages_record(sc, options, run_vo);
   summary.total_s = seconds_since(t0);
-  write_file_atomic(dir.path() / "metrics.json", summary.to_json().dump(2) + "\n");
+  write_file_atomic(dir.path() / "metrics.json", record::metrics_text(summary.run_record()));
   dir.commit();
   return summary;
 }

@@ -35,22 +35,22 @@ struct RunOptions {
 };
 
 /// What a scenario run measured, as Ceres' Solver::Summary: one typed record its stages fill,
-/// written to metrics.json by to_json() and summed up in a line by brief().
+/// turned into metrics.json's record by run_record() and summed up in a line by brief().
 struct RunSummary {
   std::string scenario;
   std::uint64_t seed = 0;
   sim::MotionSummary motion;
   std::size_t frames = 0;     ///< camera frames with ground truth
   double track_length_m = 0;  ///< camera-left path length
-  StageRecord stages;
-  nlohmann::json sensors;  ///< per sensor: samples, the GPS's sky statistics (SensorData::stats)
-  double physics_s = 0;    ///< wall-clock time of the physics stage
-  double sensors_s = 0;    ///< of the sensor stage
+  StagesRecord stages;
+  record::SensorsRecord sensors;  ///< per sensor: samples and errors (SensorData::stats)
+  double physics_s = 0;           ///< wall-clock time of the physics stage
+  double sensors_s = 0;           ///< of the sensor stage
   double total_s = 0;
   std::optional<VisionRecord> vision;  ///< render, VO, fusion, evaluation (when they ran)
   std::string brief() const;
-  /// metrics.json (docs/design.md, "Data contract of a run").
-  nlohmann::json to_json() const;
+  /// metrics.json (docs/metrics-reference.md).
+  record::RunRecord run_record() const;
 };
 
 /// Pose of the left camera (optical frame) in the body (FRD) frame, from the

@@ -117,10 +117,10 @@ std::optional<ImuBias> SensorStage::imu_bias_at(TimeNs t_ns) const {
 
 SensorData SensorStage::finish(const sim::SceneGeometry* scene) {
   Impl& s = *impl_;
-  nlohmann::json& stats = s.data.stats;
+  record::SensorsRecord& stats = s.data.stats;
   if (s.imu_csv) {
     s.imu_csv->commit();
-    stats["imu"] = {{"samples", s.data.imu.size()}, {"rate_hz", s.sc.sensors.imu.rate_hz}};
+    stats.imu = record::ImuRecord{s.data.imu.size(), s.sc.sensors.imu.rate_hz};
   }
   // What only the physics stage needed goes before the frame loop: the sample times run to the
   // motion's hard limit (24 MB for the IMU at 200 Hz), and the IMU's samples, grown by
@@ -139,11 +139,9 @@ SensorData SensorStage::finish(const sim::SceneGeometry* scene) {
       sq[2] += std::pow(wrap_angle_rad(a.euler.yaw_rad - a.true_euler.yaw_rad), 2);
     }
     const double n = std::max<double>(1.0, static_cast<double>(s.data.ahrs.size()));
-    stats["ahrs"] = {{"samples", s.data.ahrs.size()},
-                     {"rate_hz", s.sc.sensors.ahrs.rate_hz},
-                     {"roll_rmse_deg", rad2deg(std::sqrt(sq[0] / n))},
-                     {"pitch_rmse_deg", rad2deg(std::sqrt(sq[1] / n))},
-                     {"yaw_rmse_deg", rad2deg(std::sqrt(sq[2] / n))}};
+    stats.ahrs = record::AhrsRecord{s.data.ahrs.size(), s.sc.sensors.ahrs.rate_hz,
+                                    rad2deg(std::sqrt(sq[0] / n)), rad2deg(std::sqrt(sq[1] / n)),
+                                    rad2deg(std::sqrt(sq[2] / n))};
   }
   s.data.imu.shrink_to_fit();
   if (s.sc.sensors.gps.enabled) {
@@ -169,13 +167,12 @@ SensorData SensorStage::finish(const sim::SceneGeometry* scene) {
     double hdop_mean = 0.0;
     for (double h : hdop) hdop_mean += h / static_cast<double>(hdop.size());
     const double n = static_cast<double>(s.data.gps.size());
-    stats["gps"] = {
-        {"epochs", s.data.gps.size()},
-        {"fix_fraction", n > 0 ? fixes / n : 0.0},
-        {"below_min_satellites_fraction", n > 0 ? below / n : 0.0},
-        {"median_satellites", sats.empty() ? 0.0 : median(sats)},
-        {"mean_hdop_with_fix", hdop.empty() ? nlohmann::json(nullptr) : nlohmann::json(hdop_mean)},
-        {"sky", scene != nullptr ? "scene meshes" : "open"}};
+    stats.gps = record::GpsRecord{s.data.gps.size(),
+                                  n > 0 ? fixes / n : 0.0,
+                                  n > 0 ? below / n : 0.0,
+                                  sats.empty() ? 0.0 : median(sats),
+                                  hdop.empty() ? eval::kUnmeasured : hdop_mean,
+                                  scene != nullptr ? "scene meshes" : "open"};
   }
   if (s.sc.sensors.compass.enabled) {
     sim::CompassOptions options = s.sc.sensors.compass;
@@ -199,10 +196,9 @@ SensorData SensorStage::finish(const sim::SceneGeometry* scene) {
     }
     csv.commit();
     const double n = static_cast<double>(s.data.compass.size());
-    stats["compass"] = {{"samples", s.data.compass.size()},
-                        {"anomalies", options.anomalies.size()},
-                        {"heading_rmse_deg", n > 0 ? std::sqrt(sq / n) * 180 / M_PI : 0.0},
-                        {"heading_max_error_deg", worst * 180 / M_PI}};
+    stats.compass =
+        record::CompassRecord{s.data.compass.size(), options.anomalies.size(),
+                              n > 0 ? std::sqrt(sq / n) * 180 / M_PI : 0.0, worst * 180 / M_PI};
   }
   release(&s.gps_bodies);
   release(&s.compass_bodies);

@@ -15,6 +15,7 @@
 
 #include "core/trajectory_io.hpp"
 #include "pipeline/scenario.hpp"
+#include "record/run_record.hpp"
 #include "sim/render/scene_geometry.hpp"
 #include "sim/sensors/ahrs.hpp"
 #include "sim/sensors/compass.hpp"
@@ -31,7 +32,7 @@ struct SensorData {
   std::vector<sim::GpsFix> gps;
   std::vector<sim::CompassSample> compass;
   std::vector<sim::AhrsSample> ahrs;  ///< the attitude reference (evaluation only, never a filter)
-  nlohmann::json stats;               ///< per sensor: samples, and for the GPS the sky statistics
+  record::SensorsRecord stats;        ///< per sensor: samples and errors; the GPS's sky statistics
 };
 
 class SensorStage {

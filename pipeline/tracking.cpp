@@ -53,25 +53,19 @@ TrackingSummary summarize_tracking(const std::vector<vo::VoResult>& results,
   return s;
 }
 
-nlohmann::json TrackingSummary::to_json() const {
-  nlohmann::json j;
-  j["frames"] = frames;
-  j["lost_frames"] = lost;
-  j["lost_fraction"] = frames ? static_cast<double>(lost) / static_cast<double>(frames) : 0.0;
-  j["dropped_frames"] = dropped;
-  j["reasons"] = nlohmann::json::object();
-  for (const auto& [reason, n] : reasons) j["reasons"][reason] = n;
-  j["stretches"] = nlohmann::json::array();
+record::TrackingRecord TrackingSummary::tracking_record() const {
+  record::TrackingRecord r;
+  r.frames = frames;
+  r.lost_frames = lost;
+  r.lost_fraction = frames ? static_cast<double>(lost) / static_cast<double>(frames) : 0.0;
+  r.dropped_frames = dropped;
+  r.reasons = reasons;
   for (const LostStretch& l : stretches)
-    j["stretches"].push_back({{"first_frame", l.first},
-                              {"frames", l.frames()},
-                              {"t_start_s", seconds(l.t_start_ns)},
-                              {"t_end_s", seconds(l.t_end_ns)},
-                              {"track_m", l.track_m},
-                              {"reason", l.reason}});
+    r.stretches.push_back(
+        {l.first, l.frames(), seconds(l.t_start_ns), seconds(l.t_end_ns), l.track_m, l.reason});
   const LostStretch* worst = longest();
-  j["longest_stretch_frames"] = worst ? worst->frames() : 0;
-  return j;
+  r.longest_stretch_frames = worst ? worst->frames() : 0;
+  return r;
 }
 
 std::string tracking_warning(const std::string& vo_name, const TrackingSummary& s, double min_s) {

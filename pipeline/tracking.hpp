@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
+#include "record/run_record.hpp"
 
 #include "core/time.hpp"
 #include "core/trajectory_io.hpp"
@@ -33,7 +33,7 @@ struct TrackingSummary {
   std::size_t dropped = 0;  ///< frames the camera dropped (no image: not the VO's doing)
   std::map<std::string, std::size_t> reasons;  ///< lost frames by reason
   std::vector<LostStretch> stretches;          ///< in time order
-  nlohmann::json to_json() const;
+  record::TrackingRecord tracking_record() const;
   /// The longest stretch, or nullptr when the VO never lost track.
   const LostStretch* longest() const;
 };

@@ -130,7 +130,7 @@ void report_filter_counts(const std::vector<Track>& tracks, TrackRecords* record
   for (const Track& tr : tracks) {
     if (!tr.filter) continue;
     const FilterCounts c = tr.filter->counts();
-    records->algorithms[tr.name].filter = nlohmann::json(c.counts);
+    records->algorithms[tr.name].filter = c.counts;
     if (c.nonfinite_guards > 0)
       warnings->push_back(fmt::format(
           "{}: {} non-finite inputs or states were caught (skipped, or the filter restarted); "
@@ -148,17 +148,17 @@ std::string compare_filters_with_raw_vo(const std::vector<Track>& tracks, TrackR
     const auto filtered = records->algorithms.find(tr.name);
     const auto unfiltered = records->algorithms.find(raw);
     if (filtered == records->algorithms.end() || unfiltered == records->algorithms.end()) continue;
-    const std::optional<double> f = filtered->second.ape_trans_rmse_m();
-    const std::optional<double> r = unfiltered->second.ape_trans_rmse_m();
+    const std::optional<double> f = ape_trans_rmse_m(filtered->second);
+    const std::optional<double> r = ape_trans_rmse_m(unfiltered->second);
     if (!f || !r) continue;  // no associated poses
-    const VsRawVo v{raw, *f, *r};
+    const record::VsRawVoRecord v = vs_raw_vo(raw, *f, *r);
     filtered->second.vs_raw_vo = v;
-    if (!v.better())
+    if (!v.better)
       warnings->push_back(fmt::format(
           "{} is no better than its raw VO {}: APE translation RMSE {:.4g} m against {:.4g} m",
           tr.name, raw, v.filtered, v.raw));
     table += fmt::format("| {} | {} | {:.4g} | {:.4g} | {:.2f} | {} |\n", tr.name, raw, v.filtered,
-                         v.raw, v.ratio(), v.better() ? "yes" : "**no**");
+                         v.raw, v.ratio, v.better ? "yes" : "**no**");
   }
   if (table.empty()) return "";
   return "## Filters against their raw VO\n\n| filter | raw VO | APE trans. RMSE (m) | raw VO's "

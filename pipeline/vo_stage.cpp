@@ -54,7 +54,7 @@ VoTiming vo_timing(const vo::StereoOdometry& vo, double ms_per_frame) {
   t.ms_per_frame = ms_per_frame;
   if (const auto* sparse = dynamic_cast<const vo::SparseStereoOdometry*>(&vo)) {
     const auto counts = sparse->detection_counts();
-    t.sparse_pairs = VoTiming::SparsePairs{counts.detected, counts.shared};
+    t.sparse_pairs = record::SparsePairsRecord{counts.detected, counts.shared};
   }
   return t;
 }

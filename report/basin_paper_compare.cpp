@@ -4,7 +4,6 @@
 
 #include <array>
 #include <cmath>
-#include <limits>
 #include <map>
 
 #include "core/error.hpp"
@@ -48,38 +47,31 @@ constexpr std::array<Experiment, 7> kBasinPaper{{
      {{{0.298, 0.329}, {4.409, 4.945}, {0.093, 0.100}, {0.045, 0.046}, {1.582, 1.921}}}},
 }};
 
-constexpr std::array<const char*, 5> kQuantities{"north_m", "east_m", "surge_m_s", "sway_m_s",
-                                                 "heading_deg"};
+using eval::BasinRow;
+using eval::BasinRows;
+using record::RunRecord;
+
+constexpr std::array<BasinRow BasinRows::*, 5> kQuantities{
+    &BasinRows::north_m, &BasinRows::east_m, &BasinRows::surge_m_s, &BasinRows::sway_m_s,
+    &BasinRows::heading_deg};
 constexpr std::array<double, 5> kToPaperUnits{100, 100, 100, 100, 1};  // cm, cm/s, deg
 
-double number(const nlohmann::json& j, const char* key) {
-  const auto it = j.find(key);
-  return it != j.end() && it->is_number() ? it->get<double>()
-                                          : std::numeric_limits<double>::quiet_NaN();
-}
-
-// A run's row from algorithms.ALGO.TABLE (basin or basin_overhead); nullopt when missing.
-std::optional<Row> twin_row(const nlohmann::json& run, const std::string& algo, const char* table) {
-  const auto a = run.find("algorithms");
-  if (a == run.end() || !a->contains(algo) || !(*a)[algo].contains(table)) return std::nullopt;
-  const nlohmann::json& t = (*a)[algo][table];
+// A run's row of the basin table, in the paper's units.
+Row twin_row(const BasinRows& t) {
   Row r{};
-  for (std::size_t q = 0; q < 5; ++q) {
-    const nlohmann::json& c = t.contains(kQuantities[q]) ? t[kQuantities[q]] : nlohmann::json();
-    r[q] = {number(c, "rmse") * kToPaperUnits[q], number(c, "sd") * kToPaperUnits[q]};
-  }
+  for (std::size_t q = 0; q < 5; ++q)
+    r[q] = {(t.*kQuantities[q]).rmse * kToPaperUnits[q], (t.*kQuantities[q]).sd * kToPaperUnits[q]};
   return r;
 }
 
 // The run's algorithm of a filter: the one whose name ends in `suffix` (pnp_ned_kf).
-std::string algorithm_ending(const nlohmann::json& run, const std::string& suffix) {
+std::string algorithm_ending(const RunRecord& run, const std::string& suffix) {
   std::string found;
-  if (run.contains("algorithms"))
-    for (const auto& [name, value] : run["algorithms"].items())
-      if (name.size() >= suffix.size() &&
-          name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
-          (found.empty() || name.rfind("pnp", 0) == 0))
-        found = name;
+  for (const auto& [name, value] : run.algorithms)
+    if (name.size() >= suffix.size() &&
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+        (found.empty() || name.rfind("pnp", 0) == 0))
+      found = name;
   return found;
 }
 
@@ -106,8 +98,8 @@ std::string hardest(const Source& s, std::size_t q) {
   return worst ? fmt::format("largest in {}, smallest in {}", worst, best) : "—";
 }
 
-std::string table(const char* title, const std::string& suffix,
-                  const std::vector<nlohmann::json>& runs, const std::vector<int>& exps, bool kf) {
+std::string table(const char* title, const std::string& suffix, const std::vector<RunRecord>& runs,
+                  const std::vector<int>& exps, bool kf) {
   Source paper{"paper", {}}, exact{"twin, exact truth", {}}, overhead{"twin, overhead camera", {}};
   std::string algo;
   for (std::size_t i = 0; i < runs.size(); ++i) {
@@ -116,8 +108,9 @@ std::string table(const char* title, const std::string& suffix,
                        : kBasinPaper[static_cast<std::size_t>(e - 1)].pf;
     algo = algorithm_ending(runs[i], suffix);
     if (algo.empty()) continue;
-    if (auto r = twin_row(runs[i], algo, "basin")) exact.rows[e] = *r;
-    if (auto r = twin_row(runs[i], algo, "basin_overhead")) overhead.rows[e] = *r;
+    const eval::EvaluationRecord& ev = runs[i].algorithms.at(algo).evaluation;
+    exact.rows[e] = twin_row(ev.basin);
+    if (ev.basin_overhead) overhead.rows[e] = twin_row(ev.basin_overhead->rows);
   }
   std::string out = fmt::format("## {} ({})\n\n", title, algo.empty() ? "not in the runs" : algo);
   out += "| Exp. | waves (γ, ζa, λ) | against | N [cm] | E [cm] | u [cm/s] | v [cm/s] | ψ [°] |\n";
@@ -147,10 +140,10 @@ std::optional<int> basin_paper_experiment_of(const std::string& name) {
   return e >= 1 && e <= 7 ? std::optional<int>(e) : std::nullopt;
 }
 
-std::string basin_paper_side_by_side(const std::vector<nlohmann::json>& runs) {
+std::string basin_paper_side_by_side(const std::vector<RunRecord>& runs) {
   std::vector<int> exps;
-  for (const nlohmann::json& run : runs) {
-    const std::string name = run.value("scenario", std::string());
+  for (const RunRecord& run : runs) {
+    const std::string name = run.scenario.value_or("");
     const auto e = basin_paper_experiment_of(name);
     if (!e)
       throw UserError(fmt::format(

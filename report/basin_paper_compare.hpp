@@ -5,10 +5,11 @@
 // (the paper's reference, `sensors.overhead`).
 #pragma once
 
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "record/run_record.hpp"
 
 namespace driftlab::report {
 
@@ -21,6 +22,6 @@ std::optional<int> basin_paper_experiment_of(const std::string& scenario_name);
 /// overhead camera, when the run has it), and which experiment each source finds hardest.
 /// `runs` are metrics.json of basin runs. Throws UserError when one is not a basin twin or
 /// has neither filter.
-std::string basin_paper_side_by_side(const std::vector<nlohmann::json>& runs);
+std::string basin_paper_side_by_side(const std::vector<record::RunRecord>& runs);
 
 }  // namespace driftlab::report

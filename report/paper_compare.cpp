@@ -97,28 +97,28 @@ constexpr std::array<PaperColumn, 2> kPaper{{
      {6.13, 20.75, 20.03, 7.90, 36.85}},
 }};
 
-// A number at a JSON key path, NaN where missing or not a number.
-double at(const nlohmann::json& j, std::initializer_list<const char*> path) {
-  const nlohmann::json* p = &j;
-  for (const char* k : path) {
-    if (!p->is_object() || !p->contains(k)) return kNa;
-    p = &(*p)[k];
-  }
-  return p->is_number() ? p->get<double>() : kNa;
+using eval::SampleStats;
+using record::AlgorithmRecord;
+using record::RunRecord;
+
+// The run's algorithm `a` (one that twin_algorithms() found).
+const AlgorithmRecord& algo(const RunRecord& m, const std::string& a) { return m.algorithms.at(a); }
+
+// A covariate's statistics over the sections, NaN where the run has not that covariate.
+SampleStats covariate(const AlgorithmRecord& a, const char* name) {
+  const auto it = a.evaluation.covariates.find(name);
+  if (it != a.evaluation.covariates.end()) return it->second;
+  return {0, kNa, kNa, kNa, kNa, kNa, kNa};
 }
 
-// The object at `run.algorithms.<algorithm>.<keys...>`, or null where any is missing (a
-// const json's operator[] must not be asked for a missing key).
-const nlohmann::json& sub(const nlohmann::json& j, std::initializer_list<std::string_view> path) {
-  static const nlohmann::json kNull;
-  const nlohmann::json* p = &j;
-  for (std::string_view k : path) {
-    if (!p->is_object()) return kNull;
-    const auto it = p->find(k);
-    if (it == p->end()) return kNull;
-    p = &*it;
+// A regression term's coefficient, NaN where the regression did not fit it.
+eval::CoefficientRecord coefficient(const AlgorithmRecord& a, const char* term) {
+  const auto& c = a.evaluation.regression.coefficients;
+  if (c) {
+    const auto it = c->find(term);
+    if (it != c->end()) return it->second;
   }
-  return *p;
+  return {kNa, kNa, kNa, kNa, kNa, false};
 }
 
 std::string num(double v, const char* spec = "{:.3f}") {
@@ -159,11 +159,11 @@ std::string_view vo_of(std::string_view a) {
 
 // The run's algorithms that the paper's columns compare with, in order: each VO at the camera,
 // then at the prism when the run has it there too.
-std::vector<std::string> twin_algorithms(const nlohmann::json& metrics) {
+std::vector<std::string> twin_algorithms(const RunRecord& metrics) {
   std::vector<std::string> out;
   for (const std::string a : {"sparse", "sparse_kf", "dense"})
     for (const std::string& name : {a, a + std::string(kPrism)})
-      if (!sub(metrics, {"algorithms", name}).is_null()) out.push_back(name);
+      if (metrics.algorithms.count(name)) out.push_back(name);
   if (out.empty())
     throw UserError(
         "driftlab paper: the run has none of the algorithms sparse, sparse_kf and dense "
@@ -191,74 +191,75 @@ std::vector<std::string> stats_cells(const Stats& s, double n, const char* spec)
           num(s.sd, spec),  num(s.max, spec),  num(n, "{:.0f}")};
 }
 
-std::vector<std::string> twin_stats_cells(const nlohmann::json& d, const char* spec) {
-  return stats_cells(
-      {at(d, {"min"}), at(d, {"mean"}), at(d, {"median"}), at(d, {"sd"}), at(d, {"max"})},
-      at(d, {"n"}), spec);
+std::vector<std::string> twin_stats_cells(const SampleStats& d, const char* spec) {
+  return stats_cells({d.min, d.mean, d.median, d.sd, d.max}, static_cast<double>(d.n), spec);
 }
 
 const std::vector<std::string> kStatRows{"Min", "Mean", "Median", "SD", "Max", "n"};
 
-// A row of mean (SD) cells: the paper's statistics and the run's at `algorithms.A.GROUP.KEY`.
+// A row of mean (SD) cells: the paper's statistics and the run's, a member of the rows `group`
+// gives of an algorithm.
+template <class Rows>
 struct MeanSdRow {
   const char* name;
   Stats PaperColumn::*paper;
-  const char* key;
+  SampleStats Rows::*twin;
 };
 
-template <std::size_t N>
-std::string mean_sd_table(const nlohmann::json& m, const std::vector<std::string>& twins,
-                          const std::array<MeanSdRow, N>& rows, const char* group) {
+template <class Rows, std::size_t N, class Group>
+std::string mean_sd_table(const RunRecord& m, const std::vector<std::string>& twins,
+                          const std::array<MeanSdRow<Rows>, N>& rows, Group group) {
   std::vector<std::string> names;
-  for (const MeanSdRow& r : rows) names.push_back(std::string(r.name) + ", mean (SD)");
+  for (const MeanSdRow<Rows>& r : rows) names.push_back(std::string(r.name) + ", mean (SD)");
   return table(names,
                columns(
                    twins,
                    [&](const PaperColumn& p) {
                      std::vector<std::string> c;
-                     for (const MeanSdRow& r : rows)
+                     for (const MeanSdRow<Rows>& r : rows)
                        c.push_back(num((p.*r.paper).mean) + " (" + num((p.*r.paper).sd) + ")");
                      return c;
                    },
                    [&](const std::string& a) {
                      std::vector<std::string> c;
-                     for (const MeanSdRow& r : rows) {
-                       const auto& d = sub(m, {"algorithms", a, group, r.key});
-                       c.push_back(num(at(d, {"mean"})) + " (" + num(at(d, {"sd"})) + ")");
-                     }
+                     const Rows& g = group(algo(m, a));
+                     for (const MeanSdRow<Rows>& r : rows)
+                       c.push_back(num((g.*r.twin).mean) + " (" + num((g.*r.twin).sd) + ")");
                      return c;
                    }));
 }
 
 // The columns with the paper's attitude comparison: not the (prism) ones, whose truth differs
 // from the camera's in position only.
-std::vector<std::string> attitude_twins(const nlohmann::json& m,
-                                        const std::vector<std::string>& twins) {
+std::vector<std::string> attitude_twins(const RunRecord& m, const std::vector<std::string>& twins) {
   std::vector<std::string> out;
   for (const std::string& a : twins)
-    if (!at_prism(a) && !sub(m, {"algorithms", a, "paper_attitude"}).is_null()) out.push_back(a);
+    if (!at_prism(a) && algo(m, a).evaluation.paper_attitude) out.push_back(a);
   return out;
 }
 
 // Table 1's angle rows as the paper computed them (Eq. (11)): the run's AHRS against the VO's
 // angles in its first camera's frame. The paper's cells are its Table 1, computed that way.
-std::string paper_attitude_rows(const nlohmann::json& m, const std::vector<std::string>& all) {
+std::string paper_attitude_rows(const RunRecord& m, const std::vector<std::string>& all) {
   const std::vector<std::string> twins = attitude_twins(m, all);
   if (twins.empty()) return "";
-  const std::array<MeanSdRow, 3> rows{
-      {{"e'_roll, AHRS − VO (deg/m)", &PaperColumn::roll, "roll_deg_per_m"},
-       {"e'_pitch, AHRS − VO (deg/m)", &PaperColumn::pitch, "pitch_deg_per_m"},
-       {"e'_yaw, AHRS − VO (deg/m)", &PaperColumn::yaw, "yaw_deg_per_m"}}};
+  using Rows = eval::PaperAttitudeRecord;
+  const std::array<MeanSdRow<Rows>, 3> rows{
+      {{"e'_roll, AHRS − VO (deg/m)", &PaperColumn::roll, &Rows::roll_deg_per_m},
+       {"e'_pitch, AHRS − VO (deg/m)", &PaperColumn::pitch, &Rows::pitch_deg_per_m},
+       {"e'_yaw, AHRS − VO (deg/m)", &PaperColumn::yaw, &Rows::yaw_deg_per_m}}};
   return "The angle rows above compare the VO's rotation with the true one in the same camera "
          "axes. The paper compared the x-IMU's Euler angles in its own frame with the VO's in "
          "its first camera's frame (Eq. (11)); the twin's AHRS (`sensors.ahrs`) compared the "
          "same way:\n\n" +
-         mean_sd_table(m, twins, rows, "paper_attitude");
+         mean_sd_table(m, twins, rows, [](const AlgorithmRecord& a) -> const Rows& {
+           return *a.evaluation.paper_attitude;
+         });
 }
 
 // Section 3.1: the largest pitch and roll errors over the four crossings, compared as the
 // paper compared them (sparse 17.78 and 13.88 deg, dense 45.48 and 40.56 deg).
-std::string attitude_maxima(const nlohmann::json& m, const std::vector<std::string>& all) {
+std::string attitude_maxima(const RunRecord& m, const std::vector<std::string>& all) {
   const std::vector<std::string> twins = attitude_twins(m, all);
   if (twins.empty()) return "";
   std::string out =
@@ -272,31 +273,35 @@ std::string attitude_maxima(const nlohmann::json& m, const std::vector<std::stri
             return {num(sparse ? 17.78 : 45.48, "{:.2f}"), num(sparse ? 13.88 : 40.56, "{:.2f}")};
           },
           [&](const std::string& a) -> std::vector<std::string> {
-            const auto& d = sub(m, {"algorithms", a, "paper_attitude", "max_abs_deg"});
-            return {num(at(d, {"pitch"}), "{:.2f}"), num(at(d, {"roll"}), "{:.2f}")};
+            const eval::EulerDeg& d = algo(m, a).evaluation.paper_attitude->max_abs_deg;
+            return {num(d.pitch, "{:.2f}"), num(d.roll, "{:.2f}")};
           }));
   return out;
 }
 
-std::string table1(const nlohmann::json& m, const std::vector<std::string>& twins) {
+std::string table1(const RunRecord& m, const std::vector<std::string>& twins) {
   std::string out =
       "## Table 1. Position error over displacement e'_p (m/m) over the 6.5 m sections\n\n";
-  out += table(
-      kStatRows,
-      columns(
-          twins, [](const PaperColumn& p) { return stats_cells(p.ep, p.sections, "{:.3f}"); },
-          [&](const std::string& a) {
-            return twin_stats_cells(sub(m, {"algorithms", a, "sections", "p_m_per_m"}), "{:.3f}");
-          }));
+  out +=
+      table(kStatRows,
+            columns(
+                twins, [](const PaperColumn& p) { return stats_cells(p.ep, p.sections, "{:.3f}"); },
+                [&](const std::string& a) {
+                  return twin_stats_cells(algo(m, a).evaluation.sections.rows.p_m_per_m, "{:.3f}");
+                }));
   // The components: mean and SD (each work defines its axes: the twin's x is
   // the optical axis, y right, z down).
-  const std::array<MeanSdRow, 6> rows{{{"e'_x (m/m)", &PaperColumn::x, "x_m_per_m"},
-                                       {"e'_y (m/m)", &PaperColumn::y, "y_m_per_m"},
-                                       {"e'_z (m/m)", &PaperColumn::z, "z_m_per_m"},
-                                       {"e'_roll (deg/m)", &PaperColumn::roll, "roll_deg_per_m"},
-                                       {"e'_pitch (deg/m)", &PaperColumn::pitch, "pitch_deg_per_m"},
-                                       {"e'_yaw (deg/m)", &PaperColumn::yaw, "yaw_deg_per_m"}}};
-  out += mean_sd_table(m, twins, rows, "sections");
+  using Rows = eval::Table1Rows;
+  const std::array<MeanSdRow<Rows>, 6> rows{
+      {{"e'_x (m/m)", &PaperColumn::x, &Rows::x_m_per_m},
+       {"e'_y (m/m)", &PaperColumn::y, &Rows::y_m_per_m},
+       {"e'_z (m/m)", &PaperColumn::z, &Rows::z_m_per_m},
+       {"e'_roll (deg/m)", &PaperColumn::roll, &Rows::roll_deg_per_m},
+       {"e'_pitch (deg/m)", &PaperColumn::pitch, &Rows::pitch_deg_per_m},
+       {"e'_yaw (deg/m)", &PaperColumn::yaw, &Rows::yaw_deg_per_m}}};
+  out += mean_sd_table(m, twins, rows, [](const AlgorithmRecord& a) -> const Rows& {
+    return a.evaluation.sections.rows;
+  });
   out += paper_attitude_rows(m, twins);
   return out;
 }
@@ -305,7 +310,7 @@ std::string metres_pct(double m, double pct) {
   return num(m, "{:.2f}") + " (" + num(pct, "{:.2f}") + ")";
 }
 
-std::string table2(const nlohmann::json& m, const std::vector<std::string>& twins,
+std::string table2(const RunRecord& m, const std::vector<std::string>& twins,
                    RiverPaperTrack track) {
   const bool discharge = track == RiverPaperTrack::kDischarge;
   std::string out =
@@ -313,26 +318,25 @@ std::string table2(const nlohmann::json& m, const std::vector<std::string>& twin
                   discharge ? "discharge measurement (four crossings)" : "total trajectory");
   const std::vector<std::string> rows{"3D RMSE", "3D max", "2D RMSE",
                                       "2D max",  "N",      "track length error (%)"};
-  out += table(rows, columns(
-                         twins,
-                         [&](const PaperColumn& p) -> std::vector<std::string> {
-                           const TrackErrors& e = discharge ? p.discharge : p.total;
-                           return {metres_pct(e.rmse_3d, e.rmse_3d_pct),
-                                   metres_pct(e.max_3d, e.max_3d_pct),
-                                   metres_pct(e.rmse_2d, e.rmse_2d_pct),
-                                   metres_pct(e.max_2d, e.max_2d_pct),
-                                   num(e.n, "{:.0f}"),
-                                   num(e.length_error_pct, "{:+.1f}")};
-                         },
-                         [&](const std::string& a) -> std::vector<std::string> {
-                           const auto& t = sub(m, {"algorithms", a, "track"});
-                           return {metres_pct(at(t, {"rmse_3d_m"}), at(t, {"rmse_3d_pct"})),
-                                   metres_pct(at(t, {"max_3d_m"}), at(t, {"max_3d_pct"})),
-                                   metres_pct(at(t, {"rmse_2d_m"}), at(t, {"rmse_2d_pct"})),
-                                   metres_pct(at(t, {"max_2d_m"}), at(t, {"max_2d_pct"})),
-                                   num(at(t, {"n"}), "{:.0f}"),
-                                   num(at(t, {"length_error_pct"}), "{:+.1f}")};
-                         }));
+  out += table(
+      rows, columns(
+                twins,
+                [&](const PaperColumn& p) -> std::vector<std::string> {
+                  const TrackErrors& e = discharge ? p.discharge : p.total;
+                  return {metres_pct(e.rmse_3d, e.rmse_3d_pct),
+                          metres_pct(e.max_3d, e.max_3d_pct),
+                          metres_pct(e.rmse_2d, e.rmse_2d_pct),
+                          metres_pct(e.max_2d, e.max_2d_pct),
+                          num(e.n, "{:.0f}"),
+                          num(e.length_error_pct, "{:+.1f}")};
+                },
+                [&](const std::string& a) -> std::vector<std::string> {
+                  const eval::TrackRecord& t = algo(m, a).evaluation.track;
+                  return {
+                      metres_pct(t.rmse_3d_m, t.rmse_3d_pct),  metres_pct(t.max_3d_m, t.max_3d_pct),
+                      metres_pct(t.rmse_2d_m, t.rmse_2d_pct),  metres_pct(t.max_2d_m, t.max_2d_pct),
+                      num(static_cast<double>(t.n), "{:.0f}"), num(t.length_error_pct, "{:+.1f}")};
+                }));
   return out;
 }
 
@@ -341,7 +345,7 @@ std::string coefficient_cell(double beta, double t, double p) {
   return fmt::format("{:.2e} (t {:.2f}, p {:.2f}){}", beta, t, p, p < 0.05 ? " *" : "");
 }
 
-std::string table3(const nlohmann::json& m, const std::vector<std::string>& twins) {
+std::string table3(const RunRecord& m, const std::vector<std::string>& twins) {
   std::string out =
       "## Table 3. Regression of e'_p on the covariates: beta (t, p); * significant at 0.05\n\n";
   std::vector<std::string> rows(kTerms.begin(), kTerms.end());
@@ -357,21 +361,22 @@ std::string table3(const nlohmann::json& m, const std::vector<std::string>& twin
                            return c;
                          },
                          [&](const std::string& a) {
-                           const auto& r = sub(m, {"algorithms", a, "regression"});
+                           const AlgorithmRecord& al = algo(m, a);
+                           const eval::RegressionRecord& r = al.evaluation.regression;
                            std::vector<std::string> c;
-                           for (const char* term : kTerms)
-                             c.push_back(coefficient_cell(at(r, {"coefficients", term, "estimate"}),
-                                                          at(r, {"coefficients", term, "t"}),
-                                                          at(r, {"coefficients", term, "p"})));
-                           c.push_back(num(at(r, {"f"}), "{:.2f}") + " (" +
-                                       num(at(r, {"f_p"}), "{:.2f}") + ")");
-                           c.push_back(num(at(r, {"r2"}), "{:.2f}"));
+                           for (const char* term : kTerms) {
+                             const eval::CoefficientRecord k = coefficient(al, term);
+                             c.push_back(coefficient_cell(k.estimate, k.t, k.p));
+                           }
+                           c.push_back(num(r.f.value_or(kNa), "{:.2f}") + " (" +
+                                       num(r.f_p.value_or(kNa), "{:.2f}") + ")");
+                           c.push_back(num(r.r2.value_or(kNa), "{:.2f}"));
                            return c;
                          }));
   return out;
 }
 
-std::string table4(const nlohmann::json& m, const std::vector<std::string>& twins) {
+std::string table4(const RunRecord& m, const std::vector<std::string>& twins) {
   std::string out = "## Table 4. The covariates over the sections: mean (median; min-max)\n\n";
   const std::vector<std::string> rows{"v (m/s)", "h (deg)", "f (inliers; dense: pixels)", "d (m)"};
   constexpr std::array<const char*, 4> kKeys{"v", "h", "f", "d"};
@@ -390,10 +395,8 @@ std::string table4(const nlohmann::json& m, const std::vector<std::string>& twin
                       [&](const std::string& a) {
                         std::vector<std::string> c;
                         for (std::size_t r = 0; r < kKeys.size(); ++r) {
-                          const auto& d = sub(m, {"algorithms", a, "covariates", kKeys[r]});
-                          c.push_back(cell({at(d, {"min"}), at(d, {"mean"}), at(d, {"median"}),
-                                            at(d, {"sd"}), at(d, {"max"})},
-                                           r));
+                          const SampleStats d = covariate(algo(m, a), kKeys[r]);
+                          c.push_back(cell({d.min, d.mean, d.median, d.sd, d.max}, r));
                         }
                         return c;
                       }));
@@ -401,11 +404,9 @@ std::string table4(const nlohmann::json& m, const std::vector<std::string>& twin
 }
 
 // The paper's findings, each checked on the twin.
-std::string findings(const nlohmann::json& m, const std::vector<std::string>& twins) {
+std::string findings(const RunRecord& m, const std::vector<std::string>& twins) {
   std::string out = "## The paper's findings on the twin\n\n";
-  auto ep = [&](const char* a) {
-    return at(sub(m, {"algorithms", a}), {"sections", "p_m_per_m", "mean"});
-  };
+  auto ep = [&](const char* a) { return algo(m, a).evaluation.sections.rows.p_m_per_m.mean; };
   auto has = [&](const char* a) { return std::find(twins.begin(), twins.end(), a) != twins.end(); };
   if (has("dense") && has("sparse"))
     out += fmt::format(
@@ -414,9 +415,8 @@ std::string findings(const nlohmann::json& m, const std::vector<std::string>& tw
         ep("sparse") < ep("dense") ? "yes" : "no", num(ep("sparse")), num(ep("dense")));
   for (const std::string& a : twins) {
     if (vo_of(a) == "sparse_kf") continue;
-    const auto& r = sub(m, {"algorithms", a, "regression", "coefficients"});
     auto significant = [&](const char* term) {
-      const double p = at(r, {term, "p"});
+      const double p = coefficient(algo(m, a), term).p;
       return std::isfinite(p) ? (p < 0.05 ? "significant" : "not significant") : "not fitted";
     };
     out += fmt::format("- {} (Table 3): paper finds {}; twin: h {}, d {}, v {}.\n", a,
@@ -428,11 +428,9 @@ std::string findings(const nlohmann::json& m, const std::vector<std::string>& tw
 
 // Where the twin's truth was measured, when not at the camera (eval.reference_point_m): the
 // paper's truth was a prism the total station tracked, not its camera.
-std::string reference_point_note(const nlohmann::json& algorithm, std::string_view whose) {
-  const auto it = algorithm.find("association");
-  if (it == algorithm.end() || !it->contains("reference_point_m")) return "";
-  const std::vector<double> l = (*it)["reference_point_m"].get<std::vector<double>>();
-  if (l == std::vector<double>{0.0, 0.0, 0.0}) return "";
+std::string reference_point_note(const AlgorithmRecord& algorithm, std::string_view whose) {
+  const std::array<double, 3>& l = algorithm.evaluation.association.reference_point_m;
+  if (l == std::array<double, 3>{0.0, 0.0, 0.0}) return "";
   return fmt::format(
       "{} truth is measured {:.2f} m from its camera, at [{}, {}, {}] m in the camera's "
       "frame (x right, y down, z forward; `eval.reference_point_m`, `driftlab paper --prism`), "
@@ -449,20 +447,19 @@ std::optional<RiverPaperTrack> river_paper_track_of(const std::string& scenario_
   return std::nullopt;
 }
 
-std::string river_paper_side_by_side(const nlohmann::json& metrics, RiverPaperTrack track) {
+std::string river_paper_side_by_side(const RunRecord& metrics, RiverPaperTrack track) {
   const std::vector<std::string> twins = twin_algorithms(metrics);
   std::string out = fmt::format(
       "# River paper (Kriechbaumer et al. 2015, Tables 1-4) and the twin run '{}' side by side\n\n"
       "Paper: the real River Great Ouse, 96 sections (dense: 92). Twin: {} sections of {} m. "
       "`sparse` is the paper's method on both sides; `sparse_kf` (keyframes) is ours.\n\n",
-      metrics.value("scenario", std::string("?")),
-      num(at(sub(metrics, {"algorithms", twins.front()}), {"sections", "count"}), "{:.0f}"),
-      num(at(sub(metrics, {"algorithms", twins.front()}), {"sections", "section_length_m"}),
-          "{:.1f}"));
-  out += reference_point_note(sub(metrics, {"algorithms", twins.front()}), "The twin's");
+      metrics.scenario.value_or("?"),
+      num(static_cast<double>(algo(metrics, twins.front()).evaluation.sections.count), "{:.0f}"),
+      num(algo(metrics, twins.front()).evaluation.sections.section_length_m, "{:.1f}"));
+  out += reference_point_note(algo(metrics, twins.front()), "The twin's");
   for (const std::string& a : twins)
     if (at_prism(a)) {
-      out += reference_point_note(sub(metrics, {"algorithms", a}), "In the (prism) columns the");
+      out += reference_point_note(algo(metrics, a), "In the (prism) columns the");
       break;
     }
   out += table1(metrics, twins);

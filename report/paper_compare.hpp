@@ -5,9 +5,10 @@
 // agrees with the real river and where it does not.
 #pragma once
 
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+
+#include "record/run_record.hpp"
 
 namespace driftlab::report {
 
@@ -25,6 +26,6 @@ std::optional<RiverPaperTrack> river_paper_track_of(const std::string& scenario_
 /// the comparisons the twin-fidelity work asks for (does sparse beat dense,
 /// are h and d significant). `metrics` is a run's metrics.json. Throws
 /// UserError when the run has none of sparse, sparse_kf and dense.
-std::string river_paper_side_by_side(const nlohmann::json& metrics, RiverPaperTrack track);
+std::string river_paper_side_by_side(const record::RunRecord& metrics, RiverPaperTrack track);
 
 }  // namespace driftlab::report

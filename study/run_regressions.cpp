@@ -9,18 +9,22 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "core/record_json.hpp"
 #include "study/sweep_merge.hpp"
 
 namespace driftlab::study {
 
 namespace {
 
-// The value of a --regress metric in one run: a run metric by name, else a key path.
-double regression_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
+// The value of a --regress metric in one run: a run metric by name, else a key path of the
+// algorithm's record (docs/metrics-reference.md, under algorithms.NAME).
+double regression_metric_value(const record::RunRecord& metrics, const std::string& algorithm,
                                const std::string& metric) {
   for (const auto& rm : run_metrics())
     if (rm.name == metric) return run_metric_value(metrics, algorithm, rm);
-  return json_number(metrics, "algorithms." + algorithm + "." + metric);
+  const auto it = metrics.algorithms.find(algorithm);
+  if (it == metrics.algorithms.end()) return std::numeric_limits<double>::quiet_NaN();
+  return json_number(record_json::to_json(it->second), metric);
 }
 
 // The pieces of `text` between the separators (empty pieces kept).

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "eval/regression.hpp"
+#include "record/run_record.hpp"
 #include "study/sweep.hpp"
 
 namespace driftlab::study {
@@ -16,7 +17,7 @@ namespace driftlab::study {
 /// One merged run.
 struct RunData {
   const SweepJob* job;
-  nlohmann::json metrics;
+  record::RunRecord metrics;  ///< empty when the run wrote none
 };
 
 /// One --regress: a run metric (its runs.csv name, or a key path under algorithms.ALGO) on

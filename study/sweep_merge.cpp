@@ -26,31 +26,53 @@
 
 namespace driftlab::study {
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
 using pipeline::parse_scenario;
 using pipeline::Scenario;
 namespace fs = std::filesystem;
 
 const std::vector<RunMetric>& run_metrics() {
+  using A = const record::AlgorithmRecord&;
   static const std::vector<RunMetric> metrics = {
-      {"p_m_per_m_mean", "sections.p_m_per_m.mean", "mean section position error [m/m]"},
-      {"yaw_deg_per_m_mean", "sections.yaw_deg_per_m.mean", "mean section yaw error [deg/m]"},
-      {"ape_trans_rmse_m", "ape.trans_m.rmse", "APE translation RMSE [m]"},
-      {"ape_rot_rmse_deg", "ape.rot_deg.rmse", "APE rotation RMSE [deg]"},
-      {"rpe_trans_rmse_m", "rpe.trans_m.rmse", "RPE translation RMSE [m]"},
-      {"rpe_rot_rmse_deg", "rpe.rot_deg.rmse", "RPE rotation RMSE [deg]"},
-      {"track_rmse_3d_m", "track.rmse_3d_m", "track RMSE 3D [m]"},
-      {"track_length_error_pct", "track.length_error_pct", "track length error [%]"},
+      {"p_m_per_m_mean", "mean section position error [m/m]", true,
+       [](A a) { return a.evaluation.sections.rows.p_m_per_m.mean; }},
+      {"yaw_deg_per_m_mean", "mean section yaw error [deg/m]", true,
+       [](A a) { return a.evaluation.sections.rows.yaw_deg_per_m.mean; }},
+      {"ape_trans_rmse_m", "APE translation RMSE [m]", false,
+       [](A a) { return a.evaluation.ape.trans_m.rmse; }},
+      {"ape_rot_rmse_deg", "APE rotation RMSE [deg]", false,
+       [](A a) { return a.evaluation.ape.rot_deg.rmse; }},
+      {"rpe_trans_rmse_m", "RPE translation RMSE [m]", false,
+       [](A a) { return a.evaluation.rpe.errors.trans_m.rmse; }},
+      {"rpe_rot_rmse_deg", "RPE rotation RMSE [deg]", false,
+       [](A a) { return a.evaluation.rpe.errors.rot_deg.rmse; }},
+      {"track_rmse_3d_m", "track RMSE 3D [m]", false,
+       [](A a) { return a.evaluation.track.rmse_3d_m; }},
+      {"track_length_error_pct", "track length error [%]", false,
+       [](A a) { return a.evaluation.track.length_error_pct; }},
       // The basin paper's table (Section 4): what the wave sweeps are for.
-      {"basin_north_rmse_m", "basin.north_m.rmse", "basin table: north RMSE [m]"},
-      {"basin_east_rmse_m", "basin.east_m.rmse", "basin table: east RMSE [m]"},
-      {"basin_heading_rmse_deg", "basin.heading_deg.rmse", "basin table: heading RMSE [deg]"},
-      {"basin_surge_rmse_m_s", "basin.surge_m_s.rmse", "basin table: surge RMSE [m/s]"},
-      {"basin_sway_rmse_m_s", "basin.sway_m_s.rmse", "basin table: sway RMSE [m/s]"},
+      {"basin_north_rmse_m", "basin table: north RMSE [m]", false,
+       [](A a) { return a.evaluation.basin.north_m.rmse; }},
+      {"basin_east_rmse_m", "basin table: east RMSE [m]", false,
+       [](A a) { return a.evaluation.basin.east_m.rmse; }},
+      {"basin_heading_rmse_deg", "basin table: heading RMSE [deg]", false,
+       [](A a) { return a.evaluation.basin.heading_deg.rmse; }},
+      {"basin_surge_rmse_m_s", "basin table: surge RMSE [m/s]", false,
+       [](A a) { return a.evaluation.basin.surge_m_s.rmse; }},
+      {"basin_sway_rmse_m_s", "basin table: sway RMSE [m/s]", false,
+       [](A a) { return a.evaluation.basin.sway_m_s.rmse; }},
       // A VO's tracking, and a filter against the raw VO it follows (missing for the others).
-      {"lost_fraction", "tracking.lost_fraction", "share of frames without a VO motion"},
-      {"filter_vs_raw_ratio", "vs_raw_vo.ratio",
-       "filter's APE translation RMSE / its raw VO's (< 1: it helps)"},
-      {"filter_nonfinite_guards", "filter.nonfinite_guards", "filter's non-finite guards"},
+      {"lost_fraction", "share of frames without a VO motion", false,
+       [](A a) { return a.tracking ? a.tracking->lost_fraction : kNaN; }},
+      {"filter_vs_raw_ratio", "filter's APE translation RMSE / its raw VO's (< 1: it helps)", false,
+       [](A a) { return a.vs_raw_vo ? a.vs_raw_vo->ratio : kNaN; }},
+      {"filter_nonfinite_guards", "filter's non-finite guards", false,
+       [](A a) {
+         if (!a.filter) return kNaN;
+         const auto it = a.filter->find("nonfinite_guards");
+         return it == a.filter->end() ? kNaN : static_cast<double>(it->second);
+       }},
   };
   return metrics;
 }
@@ -60,8 +82,6 @@ nlohmann::ordered_json finite_or_null(double v) {
 }
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string num(double v) { return std::isfinite(v) ? yaml::format_double(v) : std::string(); }
 
@@ -137,14 +157,14 @@ std::string file_safe(const std::string& s) {
 
 }  // namespace
 
-double run_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
+double run_metric_value(const record::RunRecord& metrics, const std::string& algorithm,
                         const RunMetric& metric) {
-  const std::string at = "algorithms." + algorithm + ".";
+  const auto it = metrics.algorithms.find(algorithm);
+  if (it == metrics.algorithms.end()) return kNaN;
+  const record::AlgorithmRecord& a = it->second;
   // A run without sections has no section statistics (its zeros are not errors of 0).
-  if (std::string_view(metric.path).starts_with("sections.") &&
-      !(json_number(metrics, at + "sections.count") > 0))
-    return std::numeric_limits<double>::quiet_NaN();
-  return json_number(metrics, at + metric.path);
+  if (metric.of_sections && a.evaluation.sections.count == 0) return kNaN;
+  return metric.value(a);
 }
 
 std::string MergeSummary::brief() const {
@@ -225,17 +245,10 @@ struct Pool {
 };
 
 RunData read_run(const SweepManifest& m, const SweepJob& job) {
-  RunData rd{&job, nlohmann::json::object()};
+  RunData rd{&job, {}};
   const fs::path metrics_file = m.run_dir(job.id) / "metrics.json";
   std::error_code ec;
-  if (fs::exists(metrics_file, ec)) {
-    try {
-      rd.metrics = nlohmann::json::parse(read_text_file(metrics_file, "metrics.json"));
-    } catch (const nlohmann::json::parse_error& e) {
-      throw UserError(fmt::format("{}: not valid JSON ({}), expected the run's metrics",
-                                  metrics_file.string(), e.what()));
-    }
-  }
+  if (fs::exists(metrics_file, ec)) rd.metrics = record::read_run_record(metrics_file);
   return rd;
 }
 
@@ -274,8 +287,7 @@ Pool gather_runs(const SweepManifest& m, const SweepStatus& status) {
       pool.algorithms.push_back(name);
   };
   for (const auto& r : pool.runs)
-    if (r.metrics.contains("algorithms") && r.metrics["algorithms"].is_object())
-      for (const auto& [name, _] : r.metrics["algorithms"].items()) add_algorithm(name);
+    for (const auto& [name, _] : r.metrics.algorithms) add_algorithm(name);
   for (const auto& s : pool.sections) {
     const auto it = s.cells.find("algorithm");
     if (it != s.cells.end()) add_algorithm(it->second);

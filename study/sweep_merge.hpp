@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "record/run_record.hpp"
 #include "study/sweep.hpp"
 
 namespace driftlab::study {
@@ -60,17 +61,18 @@ struct MergeSummary {
 /// no numeric axis.
 MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& options = {});
 
-/// The run metrics that points.csv and runs.csv summarise: name and the key
-/// path under algorithms.ALGO of a run's metrics.json.
+/// The run metrics that points.csv and runs.csv summarise: name, and its value in one
+/// algorithm's record of a run's metrics.json.
 struct RunMetric {
   const char* name;
-  const char* path;
   const char* label;  // axis label of plots
+  bool of_sections;   // a section statistic: missing for a run without sections
+  double (*value)(const record::AlgorithmRecord&);
 };
 const std::vector<RunMetric>& run_metrics();
 /// A run metric of one algorithm in a run's metrics.json; NaN (missing) when absent, and for
 /// the section statistics of a run that has no section.
-double run_metric_value(const nlohmann::json& metrics, const std::string& algorithm,
+double run_metric_value(const record::RunRecord& metrics, const std::string& algorithm,
                         const RunMetric& metric);
 
 /// `v` as JSON, or null where it is not finite (JSON has no NaN).

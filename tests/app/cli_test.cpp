@@ -117,12 +117,14 @@ TEST(Cli, SchemaReferenceInDocsIsUpToDate) {
   fs::remove_all(dir);
 }
 
-// The sweep-file and baseline references come from the same visit() lists as their readers.
-TEST(Cli, SweepAndBaselineReferencesInDocsAreUpToDate) {
+// The sweep-file, baseline and metrics references come from the same visit() lists as their
+// readers.
+TEST(Cli, SweepBaselineAndMetricsReferencesInDocsAreUpToDate) {
   const fs::path dir = fresh_temp_dir("schema");
   const std::pair<std::vector<std::string>, std::string> refs[] = {
       {{"sweep", "schema"}, "docs/sweep-reference.md"},
-      {{"regress", "schema"}, "docs/baseline-reference.md"}};
+      {{"regress", "schema"}, "docs/baseline-reference.md"},
+      {{"metrics", "schema"}, "docs/metrics-reference.md"}};
   for (const auto& [args, doc] : refs) {
     std::vector<std::string> cmd = args;
     cmd.insert(cmd.end(), {"--out", (dir / "ref.md").string()});

@@ -1,4 +1,5 @@
 #include "pipeline/run.hpp"
+#include "record/run_record.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -361,6 +362,11 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   while (std::getline(frames_csv, line)) rows += line.empty() ? 0 : 1;
   EXPECT_EQ(rows, frames);
 
+  // The one reader reads metrics.json into its typed record, which writes the same bytes.
+  const record::RunRecord typed = record::read_run_record(out);
+  EXPECT_EQ(record::metrics_text(typed), slurp(out / "metrics.json"));
+  EXPECT_EQ(typed.metrics_version, record::kMetricsVersion);
+  EXPECT_EQ(typed.algorithms.at("sparse_kf").evaluation.sections.count, 2u);
   const auto m = nlohmann::json::parse(slurp(out / "metrics.json"));
   EXPECT_EQ(m["frames"].get<int>(), frames);
   EXPECT_EQ(m["seed"].get<std::uint64_t>(), sc.seed);
@@ -439,6 +445,10 @@ TEST(Run, EachFilterIsSetAgainstItsRawVoAndOneThatDoesNotHelpSaysSo) {
   sc.pipeline.fusion = {FusionAlgorithm::kCaSmoother, FusionAlgorithm::kNedKf,
                         FusionAlgorithm::kNedPf, FusionAlgorithm::kEskf};
   run_scenario(sc, out, {});
+  // Filters' counters, their comparison with the VO and the overhead camera's table: read
+  // into the typed record and written back, the same bytes.
+  EXPECT_EQ(record::metrics_text(record::read_run_record(out / "metrics.json")),
+            slurp(out / "metrics.json"));
   const auto m = nlohmann::json::parse(slurp(out / "metrics.json"));
   const std::string report = slurp(out / "report.md");
   EXPECT_NE(report.find("## Filters against their raw VO"), std::string::npos);

@@ -50,11 +50,11 @@ TEST(Tracking, CountsLostFramesByReasonAndFindsTheStretches) {
   EXPECT_EQ(s.stretches[0].t_end_ns, 600'000'000LL);
   EXPECT_EQ(s.stretches[1].first, 9u);
   EXPECT_EQ(s.longest()->first, 4u);
-  const auto j = s.to_json();
-  EXPECT_EQ(j["lost_frames"], 4);
-  EXPECT_DOUBLE_EQ(j["lost_fraction"].get<double>(), 0.5);
-  EXPECT_EQ(j["longest_stretch_frames"], 3);
-  EXPECT_EQ(j["stretches"][0]["reason"], "too few PnP inliers");
+  const auto r = s.tracking_record();
+  EXPECT_EQ(r.lost_frames, 4u);
+  EXPECT_DOUBLE_EQ(r.lost_fraction, 0.5);
+  EXPECT_EQ(r.longest_stretch_frames, 3u);
+  EXPECT_EQ(r.stretches[0].reason, "too few PnP inliers");
 }
 
 TEST(Tracking, WarnsOnlyForAStretchAsLongAsTheThreshold) {

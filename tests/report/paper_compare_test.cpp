@@ -15,6 +15,11 @@ nlohmann::json stats(double min, double mean, double median, double sd, double m
   return {{"min", min}, {"mean", mean}, {"median", median}, {"sd", sd}, {"max", max}, {"n", n}};
 }
 
+// The record the side-by-side reads, through the one reader of metrics.json.
+record::RunRecord as_record(const nlohmann::json& m) {
+  return record::run_record_from_json(m, "metrics.json");
+}
+
 // A run's metrics.json with the keys the side-by-side reads.
 nlohmann::json algorithm(double ep_mean, double h_p) {
   nlohmann::json a;
@@ -46,7 +51,7 @@ TEST(PaperCompare, PaperAndTwinColumnsSideBySideWithTheRightTrack) {
   m["scenario"] = "river_survey";
   m["algorithms"]["sparse"] = algorithm(0.0456, 0.001);
   m["algorithms"]["dense"] = algorithm(0.0321, 0.5);
-  const std::string total = river_paper_side_by_side(m, RiverPaperTrack::kTotal);
+  const std::string total = river_paper_side_by_side(as_record(m), RiverPaperTrack::kTotal);
   // The paper's printed values (Kriechbaumer et al. 2015, Tables 1-4).
   for (const char* paper :
        {"| Mean | 0.067 |", "0.177", "13.36 (2.01)", "31.49 (4.75)", "2.33e-03 (t 9.53, p 0.00) *",
@@ -67,7 +72,7 @@ TEST(PaperCompare, PaperAndTwinColumnsSideBySideWithTheRightTrack) {
       << total;
   EXPECT_NE(total.find("twin: h significant, d not significant"), std::string::npos) << total;
 
-  const std::string discharge = river_paper_side_by_side(m, RiverPaperTrack::kDischarge);
+  const std::string discharge = river_paper_side_by_side(as_record(m), RiverPaperTrack::kDischarge);
   EXPECT_NE(discharge.find("1.08 (1.99)"), std::string::npos);
   EXPECT_EQ(discharge.find("13.36 (2.01)"), std::string::npos);
 }
@@ -80,14 +85,14 @@ TEST(PaperCompare, TheAttitudeAsThePaperComparedItWhenTheRunHasAnAhrs) {
   m["scenario"] = "river_crossing";
   m["algorithms"]["sparse"] = algorithm(0.0456, 0.001);
   m["algorithms"]["sparse (prism)"] = algorithm(0.0789, 0.001);
-  const std::string without = river_paper_side_by_side(m, RiverPaperTrack::kDischarge);
+  const std::string without = river_paper_side_by_side(as_record(m), RiverPaperTrack::kDischarge);
   EXPECT_EQ(without.find("AHRS"), std::string::npos);
   nlohmann::json& a = m["algorithms"]["sparse"]["paper_attitude"];
   a["roll_deg_per_m"] = stats(-2, 0.012, 0.0, 1.234, 2, 12);
   a["pitch_deg_per_m"] = stats(-2, -0.021, 0.0, 0.987, 2, 12);
   a["yaw_deg_per_m"] = stats(-1, 0.003, 0.0, 0.321, 1, 12);
   a["max_abs_deg"] = {{"roll", 12.345}, {"pitch", 23.456}, {"yaw", 3.0}};
-  const std::string with = river_paper_side_by_side(m, RiverPaperTrack::kDischarge);
+  const std::string with = river_paper_side_by_side(as_record(m), RiverPaperTrack::kDischarge);
   EXPECT_NE(with.find("| e'_roll, AHRS − VO (deg/m), mean (SD) | 0.000 (1.250) | 0.012 (1.234) |"),
             std::string::npos)
       << with;
@@ -100,7 +105,7 @@ TEST(PaperCompare, TheAttitudeAsThePaperComparedItWhenTheRunHasAnAhrs) {
   EXPECT_NE(with.find("| e'_roll (deg/m), mean (SD) | 0.000 (1.250) | 0.004 (0.050) |"),
             std::string::npos);
   // The total trajectory has no maxima in the paper.
-  EXPECT_EQ(river_paper_side_by_side(m, RiverPaperTrack::kTotal).find("| pitch | 17.78"),
+  EXPECT_EQ(river_paper_side_by_side(as_record(m), RiverPaperTrack::kTotal).find("| pitch | 17.78"),
             std::string::npos);
 }
 
@@ -110,13 +115,13 @@ TEST(PaperCompare, SaysWhereTheTruthWasMeasuredWhenNotAtTheCamera) {
   nlohmann::json m;
   m["scenario"] = "river_survey";
   m["algorithms"]["sparse"] = algorithm(0.0456, 0.001);
-  const std::string old_run = river_paper_side_by_side(m, RiverPaperTrack::kTotal);
+  const std::string old_run = river_paper_side_by_side(as_record(m), RiverPaperTrack::kTotal);
   m["algorithms"]["sparse"]["association"]["reference_point_m"] = {0.0, 0.0, 0.0};
-  const std::string at_camera = river_paper_side_by_side(m, RiverPaperTrack::kTotal);
+  const std::string at_camera = river_paper_side_by_side(as_record(m), RiverPaperTrack::kTotal);
   EXPECT_EQ(old_run, at_camera);
   EXPECT_EQ(at_camera.find("truth is measured"), std::string::npos);
   m["algorithms"]["sparse"]["association"]["reference_point_m"] = {-0.3, -0.4, 1.2};
-  const std::string prism = river_paper_side_by_side(m, RiverPaperTrack::kTotal);
+  const std::string prism = river_paper_side_by_side(as_record(m), RiverPaperTrack::kTotal);
   EXPECT_NE(
       prism.find("The twin's truth is measured 1.30 m from its camera, at [-0.3, -0.4, 1.2] m"),
       std::string::npos)
@@ -133,7 +138,7 @@ TEST(PaperCompare, TheTwinAtTheCameraAndAtThePrismSideBySide) {
   m["algorithms"]["sparse (prism)"]["association"]["reference_point_m"] = {-0.35, -0.55, 0.606};
   m["algorithms"]["dense"] = algorithm(0.0082, 0.5);
   m["algorithms"]["dense (prism)"] = algorithm(0.0800, 0.002);
-  const std::string md = river_paper_side_by_side(m, RiverPaperTrack::kTotal);
+  const std::string md = river_paper_side_by_side(as_record(m), RiverPaperTrack::kTotal);
   EXPECT_NE(md.find("| paper sparse | twin sparse | twin sparse (prism) | paper dense | twin dense "
                     "| twin dense (prism) |"),
             std::string::npos)
@@ -161,7 +166,7 @@ TEST(PaperCompare, TracksOfTheTwinScenariosAndARunWithoutTheAlgorithms) {
   nlohmann::json m;
   m["algorithms"]["pnp"] = algorithm(0.1, 0.1);
   try {
-    river_paper_side_by_side(m, RiverPaperTrack::kTotal);
+    river_paper_side_by_side(as_record(m), RiverPaperTrack::kTotal);
     FAIL();
   } catch (const UserError& e) {
     EXPECT_NE(std::string(e.what()).find("none of the algorithms sparse, sparse_kf and dense"),

@@ -517,24 +517,28 @@ TEST(SweepMerge, RunMetricsIncludeTheBasinTableAndFilterStatisticsAndMissingIsMi
     return run_metrics().front();
   };
   nlohmann::json run;  // a 2.5 m basin tow: no 6.5 m section, a basin table
+  // The value in the run's record, read as the merge reads metrics.json.
+  const auto value = [&](const std::string& algo, const std::string& name) {
+    return run_metric_value(record::run_record_from_json(run, "metrics.json"), algo, metric(name));
+  };
   run["algorithms"]["pnp"]["sections"] = {{"count", 0}, {"p_m_per_m", {{"mean", 0.0}}}};
   run["algorithms"]["pnp"]["basin"]["north_m"]["rmse"] = 0.062;
   run["algorithms"]["pnp"]["ape"]["trans_m"]["rmse"] = 0.01;
-  EXPECT_TRUE(std::isnan(run_metric_value(run, "pnp", metric("p_m_per_m_mean"))));
-  EXPECT_EQ(run_metric_value(run, "pnp", metric("basin_north_rmse_m")), 0.062);
-  EXPECT_EQ(run_metric_value(run, "pnp", metric("ape_trans_rmse_m")), 0.01);
-  EXPECT_TRUE(std::isnan(run_metric_value(run, "pnp", metric("basin_east_rmse_m"))));
+  EXPECT_TRUE(std::isnan(value("pnp", "p_m_per_m_mean")));
+  EXPECT_EQ(value("pnp", "basin_north_rmse_m"), 0.062);
+  EXPECT_EQ(value("pnp", "ape_trans_rmse_m"), 0.01);
+  EXPECT_TRUE(std::isnan(value("pnp", "basin_east_rmse_m")));
   run["algorithms"]["pnp"]["sections"]["count"] = 3;
-  EXPECT_EQ(run_metric_value(run, "pnp", metric("p_m_per_m_mean")), 0.0);
+  EXPECT_EQ(value("pnp", "p_m_per_m_mean"), 0.0);
   // The filter statistics: a filter's ratio to its raw VO and its guards; missing for a VO.
   run["algorithms"]["pnp_ned_kf"]["vs_raw_vo"]["ratio"] = 1.19;
   run["algorithms"]["pnp_ned_kf"]["filter"]["nonfinite_guards"] = 0;
   run["algorithms"]["pnp"]["tracking"]["lost_fraction"] = 0.25;
-  EXPECT_EQ(run_metric_value(run, "pnp_ned_kf", metric("filter_vs_raw_ratio")), 1.19);
-  EXPECT_EQ(run_metric_value(run, "pnp_ned_kf", metric("filter_nonfinite_guards")), 0.0);
-  EXPECT_TRUE(std::isnan(run_metric_value(run, "pnp", metric("filter_vs_raw_ratio"))));
-  EXPECT_EQ(run_metric_value(run, "pnp", metric("lost_fraction")), 0.25);
-  EXPECT_TRUE(std::isnan(run_metric_value(run, "pnp_ned_kf", metric("lost_fraction"))));
+  EXPECT_EQ(value("pnp_ned_kf", "filter_vs_raw_ratio"), 1.19);
+  EXPECT_EQ(value("pnp_ned_kf", "filter_nonfinite_guards"), 0.0);
+  EXPECT_TRUE(std::isnan(value("pnp", "filter_vs_raw_ratio")));
+  EXPECT_EQ(value("pnp", "lost_fraction"), 0.25);
+  EXPECT_TRUE(std::isnan(value("pnp_ned_kf", "lost_fraction")));
 }
 
 // ---------------------------------------------------------------------------
@@ -806,8 +810,8 @@ TEST(RunRegressions, AConditionFitsOnlyTheRunsWithThatValue) {
   std::vector<RunData> runs;
   for (int k = 0; k < 6; ++k) {
     const double north = k < 3 ? 2.0 * amplitude[k] + 0.01 : 0.5 * amplitude[k] + 0.02;
-    nlohmann::json metrics;
-    metrics["algorithms"]["pnp"]["basin"]["north_m"]["rmse"] = north;
+    record::RunRecord metrics;
+    metrics.algorithms["pnp"].evaluation.basin.north_m.rmse = north;
     runs.push_back({&m.jobs[static_cast<std::size_t>(k)], metrics});
   }
   const auto specs =
