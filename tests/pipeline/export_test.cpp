@@ -23,6 +23,7 @@
 #include "pipeline/dataset_run.hpp"
 #include "pipeline/run.hpp"
 #include "pipeline/vo_stage.hpp"
+#include "record/run_record.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace driftlab::pipeline {
@@ -355,6 +356,12 @@ TEST(ExportFilters, EveryFilterOnTheEurocExportFollowsTheRunsFilter) {
     const Trajectory from_vo = read_tum(root / "vo/estimates" / (std::string(name) + ".tum"));
     EXPECT_LT(largest_relative_difference(from_run, from_vo), 1e-9) << name;
   }
+  // Both runs' metrics.json (a scenario run's, and `driftlab vo`'s with its dataset and levelled
+  // world), read into the typed record and written back, are the same bytes.
+  for (const char* folder : {"run", "vo"})
+    EXPECT_EQ(record::metrics_text(record::read_run_record(root / folder)),
+              slurp(root / folder / "metrics.json"))
+        << folder;
   const auto run = nlohmann::json::parse(slurp(root / "run/metrics.json"));
   const auto vo = nlohmann::json::parse(slurp(root / "vo/metrics.json"));
   for (const char* name : {"sparse_eskf", "sparse_ned_kf", "sparse_ned_pf"})  // same inputs
