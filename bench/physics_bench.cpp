@@ -3,10 +3,10 @@
 #include <benchmark/benchmark.h>
 
 #include "core/rng.hpp"
-#include "sim/vessel/guidance.hpp"
-#include "sim/vessel/simulator.hpp"
-#include "sim/waves/ripple_spectrum.hpp"
-#include "sim/waves/wave_field.hpp"
+#include "sim/physics/vessel/guidance.hpp"
+#include "sim/physics/vessel/simulator.hpp"
+#include "sim/physics/waves/ripple_spectrum.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 
 namespace {
 

@@ -10,7 +10,7 @@ install(TARGETS ${driftlab_modules} EXPORT driftlabTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(TARGETS driftlab driftlab-gate RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-foreach(dir core sim scenes dataset vo fusion eval report pipeline study gate app)
+foreach(dir core sim scenes dataset vo fusion eval record report pipeline study gate app)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/${dir}
           FILES_MATCHING PATTERN "*.hpp" PATTERN "assets" EXCLUDE)
 endforeach()

@@ -8,7 +8,7 @@
 
 #include "core/hash.hpp"
 #include "core/yaml_io.hpp"
-#include "sim/waves/ripple_spectrum.hpp"
+#include "sim/physics/waves/ripple_spectrum.hpp"
 
 namespace driftlab::pipeline {
 namespace {

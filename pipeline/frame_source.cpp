@@ -14,9 +14,9 @@
 #include "core/stopwatch.hpp"
 #include "pipeline/frame_cache_key.hpp"
 #include "pipeline/render_stage.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 #include "sim/render/gl_context.hpp"
 #include "sim/render/renderer.hpp"
-#include "sim/waves/wave_field.hpp"
 
 namespace driftlab::pipeline {
 

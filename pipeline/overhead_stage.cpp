@@ -12,8 +12,8 @@
 #include "pipeline/render_stage.hpp"
 #include "scenes/ship_model.hpp"
 #include "scenes/wave_basin.hpp"
+#include "sim/physics/vessel/vessel_model.hpp"
 #include "sim/render/renderer.hpp"
-#include "sim/vessel/vessel_model.hpp"
 
 namespace driftlab::pipeline {
 namespace {

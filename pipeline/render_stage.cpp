@@ -17,8 +17,8 @@
 #include "pipeline/frame_source.hpp"
 #include "pipeline/run.hpp"
 #include "scenes/build_scene.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 #include "sim/render/renderer.hpp"
-#include "sim/waves/wave_field.hpp"
 
 namespace driftlab::pipeline {
 namespace {

@@ -32,9 +32,9 @@
 #include "report/run_report.hpp"
 #include "scenes/assets.hpp"
 #include "scenes/build_scene.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 #include "sim/render/renderer.hpp"
 #include "sim/sensors/clock.hpp"
-#include "sim/waves/wave_field.hpp"
 #include "vo/sparse/sparse_vo.hpp"
 
 #include <opencv2/core.hpp>

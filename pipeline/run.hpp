@@ -21,8 +21,8 @@
 #include "pipeline/run_record.hpp"
 #include "pipeline/scenario.hpp"
 #include "pipeline/sensor_stage.hpp"
+#include "sim/physics/vessel/simulator.hpp"
 #include "sim/render/scene_geometry.hpp"
-#include "sim/vessel/simulator.hpp"
 
 namespace driftlab::pipeline {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "sim/waves/wave_field.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 
 namespace driftlab::pipeline {
 namespace {

@@ -16,12 +16,12 @@
 #include "core/trajectory_io.hpp"
 #include "pipeline/scenario.hpp"
 #include "record/run_record.hpp"
+#include "sim/physics/vessel/simulator.hpp"
 #include "sim/render/scene_geometry.hpp"
 #include "sim/sensors/ahrs.hpp"
 #include "sim/sensors/compass.hpp"
 #include "sim/sensors/gps.hpp"
 #include "sim/sensors/imu.hpp"
-#include "sim/vessel/simulator.hpp"
 
 namespace driftlab::pipeline {
 

@@ -5,9 +5,9 @@
 
 #include <vector>
 
+#include "sim/physics/vessel/vessel_options.hpp"
 #include "sim/render/scene_geometry.hpp"
 #include "sim/sensors/overhead_options.hpp"
-#include "sim/vessel/vessel_options.hpp"
 
 namespace driftlab::scenes {
 

@@ -8,7 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "core/error.hpp"
-#include "sim/wind/gusts.hpp"
+#include "sim/physics/wind/gusts.hpp"
 
 namespace driftlab::scenes {
 

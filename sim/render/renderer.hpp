@@ -18,12 +18,12 @@
 
 #include "core/camera.hpp"
 #include "core/se3.hpp"
+#include "sim/physics/waves/ripple_spectrum.hpp"
+#include "sim/physics/waves/wave_field.hpp"
+#include "sim/physics/wind/gusts.hpp"
 #include "sim/render/gl_context.hpp"
 #include "sim/render/render_options.hpp"
 #include "sim/render/scene_geometry.hpp"
-#include "sim/waves/ripple_spectrum.hpp"
-#include "sim/waves/wave_field.hpp"
-#include "sim/wind/gusts.hpp"
 
 namespace driftlab::sim {
 

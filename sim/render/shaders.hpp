@@ -222,7 +222,7 @@ void main() {
 }
 )";
 
-// The wave components (sim/waves/wave_field.hpp), shared by the water's two stages: the
+// The wave components (sim/physics/waves/wave_field.hpp), shared by the water's two stages: the
 // vertex stage displaces the grid with them, the fragment stage takes its normal from them.
 inline constexpr const char* kWaterWaves = R"(
 const int N = 32;
@@ -319,7 +319,7 @@ in vec3 v_world;
 #if RIPPLES && !DEPTH
 in vec4 v_jacobian;
 #endif
-// Wind ripples (sim/waves/ripple_spectrum.hpp): two repeating tiles of slope
+// Wind ripples (sim/physics/waves/ripple_spectrum.hpp): two repeating tiles of slope
 // moments (sx, sy, sx^2, sy^2), each with its inverse size [1/m] and the eye's
 // position in it (in tiles, reduced on the CPU in double).
 uniform sampler2D u_ripple_map0;

@@ -17,11 +17,11 @@
 
 #include "core/rng.hpp"
 #include "core/rotation.hpp"
+#include "sim/physics/vessel/simulator.hpp"
 #include "sim/sensors/clock.hpp"
 #include "sim/sensors/csv_detail.hpp"
 #include "sim/sensors/imu.hpp"
 #include "sim/sensors/sensor_options.hpp"
-#include "sim/vessel/simulator.hpp"
 
 namespace driftlab::sim {
 

@@ -15,7 +15,7 @@
 
 #include "core/error.hpp"
 #include "core/rotation.hpp"
-#include "sim/vessel/simulator.hpp"
+#include "sim/physics/vessel/simulator.hpp"
 
 namespace driftlab::sim {
 namespace {

@@ -18,10 +18,10 @@
 #include "core/rng.hpp"
 #include "core/rotation.hpp"
 #include "core/time.hpp"
+#include "sim/physics/vessel/simulator.hpp"
 #include "sim/sensors/clock.hpp"
 #include "sim/sensors/csv_detail.hpp"
 #include "sim/sensors/sensor_options.hpp"
-#include "sim/vessel/simulator.hpp"
 
 namespace driftlab::sim {
 

@@ -18,12 +18,12 @@
 #include "core/atomic_file.hpp"
 #include "core/rng.hpp"
 #include "core/time.hpp"
+#include "sim/physics/vessel/simulator.hpp"
 #include "sim/sensors/clock.hpp"
 #include "sim/sensors/csv_detail.hpp"
 #include "sim/sensors/geodesy.hpp"
 #include "sim/sensors/sensor_options.hpp"
 #include "sim/sensors/sky.hpp"
-#include "sim/vessel/simulator.hpp"
 
 namespace driftlab::sim {
 

@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 #include "sim/sensors/csv_detail.hpp"
-#include "sim/waves/wave_field.hpp"
 
 namespace driftlab::sim {
 

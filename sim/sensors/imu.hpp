@@ -25,10 +25,10 @@
 #include "core/atomic_file.hpp"
 #include "core/rng.hpp"
 #include "core/trajectory_io.hpp"
+#include "sim/physics/vessel/simulator.hpp"
 #include "sim/sensors/clock.hpp"
 #include "sim/sensors/csv_detail.hpp"
 #include "sim/sensors/sensor_options.hpp"
-#include "sim/vessel/simulator.hpp"
 
 namespace driftlab::sim {
 

@@ -17,7 +17,7 @@ set(script ${SOURCE_DIR}/cmake/DriftlabRendererIdentity.cmake)
 # 1. What the build hashes.
 file(STRINGS "${LIST_FILE}" listed)
 foreach(f sim/render/renderer.cpp sim/render/shaders.hpp sim/render/gl_context.cpp
-          sim/sensors/camera_effects.cpp sim/sensors/lens.cpp sim/waves/wave_field.cpp
+          sim/sensors/camera_effects.cpp sim/sensors/lens.cpp sim/physics/waves/wave_field.cpp
           scenes/build_scene.cpp scenes/textures.cpp scenes/river_reach.cpp
           pipeline/camera_stage.cpp pipeline/frame_source.cpp pipeline/render_stage.cpp
           pipeline/frame_cache_key.cpp core/rng.cpp)

@@ -22,11 +22,11 @@
 #include "core/rng.hpp"
 #include "core/rotation.hpp"
 #include "core/yaml_io.hpp"
+#include "sim/physics/vessel/simulator.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 #include "sim/sensors/compass.hpp"
 #include "sim/sensors/gps.hpp"
 #include "sim/sensors/imu.hpp"
-#include "sim/vessel/simulator.hpp"
-#include "sim/waves/wave_field.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace driftlab::fusion {

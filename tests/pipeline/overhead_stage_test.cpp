@@ -11,7 +11,7 @@
 #include "pipeline/scenario.hpp"
 #include "scenes/build_scene.hpp"
 #include "scenes/ship_model.hpp"
-#include "sim/vessel/vessel_model.hpp"
+#include "sim/physics/vessel/vessel_model.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace driftlab::pipeline {

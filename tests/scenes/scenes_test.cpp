@@ -28,7 +28,7 @@
 #include "scenes/trees.hpp"
 #include "scenes/vessels.hpp"
 #include "scenes/wave_basin.hpp"
-#include "sim/wind/gusts.hpp"
+#include "sim/physics/wind/gusts.hpp"
 
 namespace driftlab::scenes {
 namespace {

@@ -1,7 +1,7 @@
-// The wind in the vegetation (sim/wind/gusts.hpp): the sway's variance is the integral of the
-// oscillator's response to the Kaimal gusts (an independent quadrature, and the time series
+// The wind in the vegetation (sim/physics/wind/gusts.hpp): the sway's variance is the integral of
+// the oscillator's response to the Kaimal gusts (an independent quadrature, and the time series
 // sampled), the gusts move downwind at the mean wind, and no wind is no sway.
-#include "sim/wind/gusts.hpp"
+#include "sim/physics/wind/gusts.hpp"
 
 #include <gtest/gtest.h>
 

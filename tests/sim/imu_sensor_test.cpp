@@ -13,9 +13,9 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "core/rotation.hpp"
+#include "sim/physics/vessel/simulator.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 #include "sim/sensors/imu.hpp"
-#include "sim/vessel/simulator.hpp"
-#include "sim/waves/wave_field.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {

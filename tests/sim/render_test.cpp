@@ -15,9 +15,9 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "core/rotation.hpp"
+#include "sim/physics/waves/wave_field.hpp"
+#include "sim/physics/wind/gusts.hpp"
 #include "sim/render/mip_chain.hpp"
-#include "sim/waves/wave_field.hpp"
-#include "sim/wind/gusts.hpp"
 #include "tests/sim/render_fixtures.hpp"
 #include "tests/support/test_support.hpp"
 

@@ -1,6 +1,6 @@
 // Wind ripples from the Elfouhaily et al. (1997) spectrum: the spectrum against
 // closed forms and published figures, the slope maps against the spectrum.
-#include "sim/waves/ripple_spectrum.hpp"
+#include "sim/physics/waves/ripple_spectrum.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <numbers>
 
 #include "core/error.hpp"
-#include "sim/waves/wave_field.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 #include "tests/support/test_support.hpp"
 
 namespace driftlab::sim {

@@ -1,4 +1,4 @@
-#include "sim/waves/wave_field.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "sim/vessel/guidance.hpp"
+#include "sim/physics/vessel/guidance.hpp"
 
 #include <fmt/format.h>
 

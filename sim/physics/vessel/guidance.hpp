@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/vessel/vessel_model.hpp"
+#include "sim/physics/vessel/vessel_model.hpp"
 
 namespace driftlab::sim {
 

@@ -1,4 +1,4 @@
-#include "sim/vessel/simulator.hpp"
+#include "sim/physics/vessel/simulator.hpp"
 
 #include <fmt/format.h>
 

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "core/time.hpp"
-#include "sim/vessel/guidance.hpp"
-#include "sim/vessel/vessel_model.hpp"
+#include "sim/physics/vessel/guidance.hpp"
+#include "sim/physics/vessel/vessel_model.hpp"
 
 namespace driftlab::sim {
 

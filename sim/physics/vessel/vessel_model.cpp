@@ -1,4 +1,4 @@
-#include "sim/vessel/vessel_model.hpp"
+#include "sim/physics/vessel/vessel_model.hpp"
 
 #include <fmt/format.h>
 

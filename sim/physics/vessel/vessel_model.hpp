@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "core/se3.hpp"
-#include "sim/vessel/vessel_options.hpp"
-#include "sim/waves/wave_field.hpp"
+#include "sim/physics/vessel/vessel_options.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 
 namespace driftlab::sim {
 

@@ -11,7 +11,7 @@
 //   [OB10] M. Olano, D. Baker (2010), "LEAN mapping", I3D: filtered first and
 //         second moments of slope give the slope variance a filter footprint hides.
 
-#include "sim/waves/ripple_spectrum.hpp"
+#include "sim/physics/waves/ripple_spectrum.hpp"
 
 #include <fftw3.h>
 
@@ -25,7 +25,7 @@
 
 #include "core/error.hpp"
 #include "core/yaml_io.hpp"
-#include "sim/waves/wave_field.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 
 // Same bytes whether or not a compiler would fuse a * b + c (see core/rng.cpp).
 #ifdef __clang__

@@ -17,7 +17,7 @@
 //   [J87] E. R. Jefferys (1987), "Directional seas should be ergodic", Applied
 //         Ocean Research 9(4), 186-191.
 
-#include "sim/waves/wave_field.hpp"
+#include "sim/physics/waves/wave_field.hpp"
 
 #include <algorithm>
 #include <cmath>

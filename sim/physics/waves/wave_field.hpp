@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/rng.hpp"
-#include "sim/waves/wave_options.hpp"
+#include "sim/physics/waves/wave_options.hpp"
 
 namespace driftlab::sim {
 

@@ -1,4 +1,4 @@
-#include "sim/wind/gusts.hpp"
+#include "sim/physics/wind/gusts.hpp"
 
 #include <algorithm>
 #include <cmath>

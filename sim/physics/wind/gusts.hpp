@@ -26,7 +26,7 @@
 #include <Eigen/Core>
 
 #include "core/rng.hpp"
-#include "sim/waves/wave_options.hpp"
+#include "sim/physics/waves/wave_options.hpp"
 
 namespace driftlab::sim {
 
