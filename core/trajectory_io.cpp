@@ -17,6 +17,7 @@
 #include "core/csv.hpp"
 #include "core/enum_names.hpp"
 #include "core/error.hpp"
+#include "core/number.hpp"
 
 namespace driftlab {
 namespace fs = std::filesystem;
@@ -145,26 +146,10 @@ void check_column_count(const LineCursor& c, const std::vector<std::string_view>
            columns.describe());
 }
 
-enum class NumberStatus { kOk, kNotNumber, kNotFinite, kOutOfRange };
-
-NumberStatus parse_double(std::string_view s, double* v) {
-  // from_chars rejects a leading '+', which some writers emit.
-  if (s.size() > 1 && s[0] == '+' && s[1] != '-') s.remove_prefix(1);
-  if (s.empty()) return NumberStatus::kNotNumber;
-  const char* end = s.data() + s.size();
-  const auto [ptr, ec] = std::from_chars(s.data(), end, *v);
-  if (ec == std::errc::invalid_argument || ptr != end) return NumberStatus::kNotNumber;
-  if (ec == std::errc::result_out_of_range) return NumberStatus::kOutOfRange;
-  if (!std::isfinite(*v)) return NumberStatus::kNotFinite;
-  return NumberStatus::kOk;
-}
+NumberStatus parse_double(std::string_view s, double* v) { return read_number(s, v); }
 
 bool parse_int64(std::string_view s, std::int64_t* v) {
-  if (s.size() > 1 && s[0] == '+' && s[1] != '-') s.remove_prefix(1);
-  if (s.empty()) return false;
-  const char* end = s.data() + s.size();
-  const auto [ptr, ec] = std::from_chars(s.data(), end, *v);
-  return ec == std::errc() && ptr == end;
+  return read_number(s, v) == NumberStatus::kOk;
 }
 
 double column_double(const LineCursor& c, const std::vector<std::string_view>& tokens,

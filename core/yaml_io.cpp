@@ -10,6 +10,7 @@
 
 #include "core/file_io.hpp"
 #include "core/markup.hpp"
+#include "core/number.hpp"
 
 namespace driftlab::yaml {
 
@@ -121,50 +122,32 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 }
 
 bool parse_double(std::string_view text, double* out) {
-  if (text.empty()) return false;
-  // YAML spellings of the special values, so that they are recognised and then
-  // rejected as non-finite with a precise message rather than "not a number".
-  static const std::pair<std::string_view, double> kSpecial[] = {
+  // YAML's spellings of the special values (core/number.hpp reads nan and inf), so that they are
+  // recognised and then rejected as non-finite with a precise message rather than "not a number".
+  static const std::pair<std::string_view, double> kYamlSpecial[] = {
       {".nan", std::numeric_limits<double>::quiet_NaN()},
       {".NaN", std::numeric_limits<double>::quiet_NaN()},
       {".NAN", std::numeric_limits<double>::quiet_NaN()},
-      {"nan", std::numeric_limits<double>::quiet_NaN()},
-      {"NaN", std::numeric_limits<double>::quiet_NaN()},
       {".inf", std::numeric_limits<double>::infinity()},
       {".Inf", std::numeric_limits<double>::infinity()},
       {"+.inf", std::numeric_limits<double>::infinity()},
-      {"-.inf", -std::numeric_limits<double>::infinity()},
-      {"inf", std::numeric_limits<double>::infinity()},
-      {"-inf", -std::numeric_limits<double>::infinity()}};
-  for (const auto& [name, value] : kSpecial) {
+      {"-.inf", -std::numeric_limits<double>::infinity()}};
+  for (const auto& [name, value] : kYamlSpecial) {
     if (text == name) {
       *out = value;
       return true;
     }
   }
-  const char* first = text.data();
-  const char* last = text.data() + text.size();
-  if (*first == '+') ++first;
-  auto [ptr, ec] = std::from_chars(first, last, *out);
-  return ec == std::errc() && ptr == last;
+  const NumberStatus s = read_number(text, out);
+  return s == NumberStatus::kOk || s == NumberStatus::kNotFinite;
 }
 
 bool parse_int64(std::string_view text, std::int64_t* out) {
-  if (text.empty()) return false;
-  const char* first = text.data();
-  const char* last = text.data() + text.size();
-  if (*first == '+') ++first;
-  auto [ptr, ec] = std::from_chars(first, last, *out);
-  return ec == std::errc() && ptr == last;
+  return read_number(text, out) == NumberStatus::kOk;
 }
 
 bool parse_uint64(std::string_view text, std::uint64_t* out) {
-  if (text.empty() || text[0] == '-') return false;
-  const char* first = text.data();
-  const char* last = text.data() + text.size();
-  if (*first == '+') ++first;
-  auto [ptr, ec] = std::from_chars(first, last, *out);
-  return ec == std::errc() && ptr == last;
+  return read_number(text, out) == NumberStatus::kOk;
 }
 
 std::string describe_node(const YAML::Node& node) {

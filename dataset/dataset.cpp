@@ -12,6 +12,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/number.hpp"
 #include "core/rotation.hpp"
 #include "core/yaml_io.hpp"
 #include "dataset/dataset_detail.hpp"
@@ -159,8 +160,7 @@ double parse_number(std::string_view token, const fs::path& path, int line,
   while (!token.empty() && (token.front() == ' ' || token.front() == '\t')) token.remove_prefix(1);
   while (!token.empty() && (token.back() == ' ' || token.back() == '\t')) token.remove_suffix(1);
   double value = 0;
-  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (ec != std::errc() || end != token.data() + token.size() || !std::isfinite(value))
+  if (read_number(token, &value) != NumberStatus::kOk)
     throw UserError(fmt::format("{}:{}: {}: got '{}', expected a finite number", path.string(),
                                 line, field, token.substr(0, 80)));
   return value;
@@ -170,8 +170,7 @@ TimeNs parse_stamp_ns(std::string_view token, const fs::path& path, int line) {
   while (!token.empty() && (token.front() == ' ' || token.front() == '\t')) token.remove_prefix(1);
   while (!token.empty() && (token.back() == ' ' || token.back() == '\t')) token.remove_suffix(1);
   TimeNs value = 0;
-  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (ec != std::errc() || end != token.data() + token.size() || value < 0)
+  if (read_number(token, &value) != NumberStatus::kOk || value < 0)
     throw UserError(
         fmt::format("{}:{}: timestamp: got '{}', expected a non-negative integer in nanoseconds",
                     path.string(), line, token.substr(0, 80)));

@@ -23,6 +23,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/hash.hpp"
+#include "core/number.hpp"
 
 namespace driftlab::pipeline {
 
@@ -85,9 +86,7 @@ bool decode_image(const std::string& bytes, int width, int height, sim::GrayImag
 
 template <class T>
 bool parse_number(const std::string& text, T* value) {
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, *value);
-  return ec == std::errc() && ptr == end;
+  return read_number(text, value) == NumberStatus::kOk;
 }
 
 bool parse_hash(const std::string& text, std::uint64_t* value) {

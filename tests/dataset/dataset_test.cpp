@@ -229,6 +229,12 @@ TEST(DatasetReaders, NameTheFileLineAndExpectation) {
   std::ofstream(calib) << "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nP1: 1 0 0 0 0 1 0 0 0 0 1 0\n";
   e = driftlab::test::user_error_of([&] { read_dataset(root, DatasetFormat::kKitti); });
   EXPECT_NE(e.find("not a rectified pair"), std::string::npos) << e;
+  // A leading '+' reads as in a KITTI pose (the one number rule, core/number.hpp); "+-" does not.
+  std::ofstream(calib) << "P0: +1 0 0 0 0 1 0 0 0 0 1 0\nP1: 1 0 0 -0.5 0 1 0 0 0 0 1 0\n";
+  EXPECT_EQ(read_dataset(root, DatasetFormat::kKitti).rig.baseline_m, 0.5);
+  std::ofstream(calib) << "P0: +-1 0 0 0 0 1 0 0 0 0 1 0\nP1: 1 0 0 -0.5 0 1 0 0 0 0 1 0\n";
+  e = driftlab::test::user_error_of([&] { read_dataset(root, DatasetFormat::kKitti); });
+  EXPECT_NE(e.find(":1: P0: got '+-1', expected a finite number"), std::string::npos) << e;
   e = driftlab::test::user_error_of([&] {
     read_dataset(root, DatasetFormat::kKitti,
                  {.sequence = "07", .gt_topic = {}, .calibration = {}});
