@@ -1,5 +1,9 @@
 #include "core/csv.hpp"
 
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
 namespace driftlab {
 namespace {
 
@@ -44,6 +48,37 @@ std::vector<std::string> split_csv_line(std::string_view line, CsvTrim trim) {
   }
   finish();
   return cells;
+}
+
+std::optional<std::size_t> CsvTable::column(std::string_view name) const {
+  for (std::size_t i = 0; i < header.size(); ++i)
+    if (header[i] == name) return i;
+  return std::nullopt;
+}
+
+CsvTable read_csv_table(std::string_view text, const std::string& source,
+                        const CsvTableOptions& options) {
+  CsvTable t;
+  std::size_t line_no = 0;
+  while (!text.empty()) {
+    const std::size_t end = text.find('\n');
+    std::string_view line = text.substr(0, end);
+    text = end == std::string_view::npos ? std::string_view() : text.substr(end + 1);
+    ++line_no;
+    if (line.find_first_not_of(" \t\r") == std::string_view::npos) continue;
+    if (options.comments && line.front() == '#') continue;
+    std::vector<std::string> cells = split_csv_line(line, options.trim);
+    if (t.header_line == 0) {
+      t.header = std::move(cells);
+      t.header_line = line_no;
+      continue;
+    }
+    if (cells.size() != t.header.size())
+      throw UserError(fmt::format("{}:{}: got {} cells, expected {} like the header", source,
+                                  line_no, cells.size(), t.header.size()));
+    t.rows.push_back({line_no, std::move(cells)});
+  }
+  return t;
 }
 
 std::string csv_cell(std::string_view s) {

@@ -9,6 +9,7 @@
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "core/file_io.hpp"
 #include "core/yaml_io.hpp"
 
 namespace driftlab::eval {
@@ -120,19 +121,12 @@ double Section::covariate(std::string_view name) const {
 }
 
 FrameTable read_frame_table(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw UserError(fmt::format("{}: cannot open for reading", path));
-  std::string line;
-  int line_no = 0;
-  std::vector<std::string> header;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
-    header = split_csv_line(line, CsvTrim::kSpaces);
-    break;
-  }
-  if (header.empty())
+  const CsvTable csv = read_csv_table(read_text_file(path, "frame table"), path,
+                                      {.trim = CsvTrim::kSpaces, .comments = true});
+  const std::vector<std::string>& header = csv.header;
+  if (csv.header_line == 0)
     throw UserError(fmt::format("{}: no header line, expected CSV with a header", path));
+  const std::size_t line_no = csv.header_line;
   int time_col = -1;
   bool time_in_ns = false;
   FrameTable table;
@@ -156,18 +150,13 @@ FrameTable read_frame_table(const std::string& path) {
     throw UserError(
         fmt::format("{}:{}: no time column, expected one named t_ns, t or t_s", path, line_no));
   table.columns.resize(table.names.size());
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
-    const auto cells = split_csv_line(line, CsvTrim::kSpaces);
-    if (cells.size() != header.size())
-      throw UserError(fmt::format("{}:{}: got {} columns, expected {} as in the header", path,
-                                  line_no, cells.size(), header.size()));
+  for (const CsvTable::Row& row : csv.rows) {
+    const std::vector<std::string>& cells = row.cells;
     const std::string& tcell = cells[static_cast<std::size_t>(time_col)];
     TimeNs t = 0;
     std::int64_t ti = 0;
     if (time_in_ns ? !yaml::parse_int64(tcell, &ti) : !parse_seconds(tcell, &t))
-      throw UserError(fmt::format("{}:{}: {}: got '{}', expected a time in {}", path, line_no,
+      throw UserError(fmt::format("{}:{}: {}: got '{}', expected a time in {}", path, row.line,
                                   header[static_cast<std::size_t>(time_col)], tcell,
                                   time_in_ns ? "integer nanoseconds" : "seconds"));
     if (time_in_ns) t = ti;
@@ -175,13 +164,13 @@ FrameTable read_frame_table(const std::string& path) {
       throw UserError(
           fmt::format("{}:{}: time {} is not after the previous row's {}, expected "
                       "strictly increasing times",
-                      path, line_no, format_seconds(t), format_seconds(table.t_ns.back())));
+                      path, row.line, format_seconds(t), format_seconds(table.t_ns.back())));
     table.t_ns.push_back(t);
     for (std::size_t c = 0; c < cells.size(); ++c) {
       if (col_of_cell[c] < 0) continue;
       double v = kNaN;
       if (!cells[c].empty() && cells[c] != "nan" && !yaml::parse_double(cells[c], &v))
-        throw UserError(fmt::format("{}:{}: {}: got '{}', expected a number", path, line_no,
+        throw UserError(fmt::format("{}:{}: {}: got '{}', expected a number", path, row.line,
                                     header[c], cells[c]));
       if (!std::isfinite(v)) v = kNaN;
       table.columns[static_cast<std::size_t>(col_of_cell[c])].push_back(v);

@@ -70,28 +70,17 @@ struct SectionRows {
 
 SectionRows split_sections(const std::string& sections_csv) {
   SectionRows out;
-  std::istringstream in(sections_csv);
-  std::string line;
-  std::getline(in, line);
-  const std::vector<std::string> header = split_csv_line(line);
-  auto column = [&header](const std::string& name) {
-    for (std::size_t i = 0; i < header.size(); ++i)
-      if (header[i] == name) return static_cast<int>(i);
-    return -1;
-  };
+  const CsvTable t = read_csv_table(sections_csv, "sections.csv");
   const std::vector<std::string> cov_names = {"v", "h", "f", "d"};
-  const int c_alg = column("algorithm"), c_p = column("p_m_per_m");
-  while (std::getline(in, line)) {
-    const auto cells = split_csv_line(line);
-    if (c_alg < 0 || c_p < 0 || cells.size() != header.size()) continue;
-    const std::string& alg = cells[static_cast<std::size_t>(c_alg)];
+  const auto c_alg = t.column("algorithm"), c_p = t.column("p_m_per_m");
+  if (!c_alg || !c_p) return out;
+  for (const CsvTable::Row& r : t.rows) {
+    const std::string& alg = r.cells[*c_alg];
     if (!out.rows.count(alg)) out.order.push_back(alg);
-    std::string row = cells[static_cast<std::size_t>(c_p)];
+    std::string row = r.cells[*c_p];
     for (const auto& c : cov_names) {
-      const int i = column(c);
-      row += " " + (i >= 0 && !cells[static_cast<std::size_t>(i)].empty()
-                        ? cells[static_cast<std::size_t>(i)]
-                        : std::string("NaN"));
+      const auto i = t.column(c);
+      row += " " + (i && !r.cells[*i].empty() ? r.cells[*i] : std::string("NaN"));
     }
     out.rows[alg] += row + "\n";
   }

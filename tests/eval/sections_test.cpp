@@ -194,7 +194,9 @@ TEST(Sections, ReadsFrameTableAndRejectsBadFiles) {
   EXPECT_NE(message("t_ns,x\n5,1\n5,2\n").find("frames.csv:3: time"), std::string::npos);
   EXPECT_NE(message("t_ns,x\n5,abc\n").find("frames.csv:2: x: got 'abc', expected a number"),
             std::string::npos);
-  EXPECT_NE(message("t_ns,x\n5,1,2\n").find("got 3 columns, expected 2"), std::string::npos);
+  EXPECT_NE(
+      message("t_ns,x\n5,1,2\n").find("frames.csv:2: got 3 cells, expected 2 like the header"),
+      std::string::npos);
   EXPECT_THROW(read_frame_table((dir / "missing.csv").string()), UserError);
   std::filesystem::remove_all(dir);
 }
