@@ -23,6 +23,8 @@
 #include "gate/paired.hpp"
 #include "pipeline/scenario.hpp"
 #include "study/run_regressions.hpp"
+#include "study/sweep_plots.hpp"
+#include "study/sweep_pool.hpp"
 
 namespace driftlab::study {
 
@@ -83,76 +85,12 @@ nlohmann::ordered_json finite_or_null(double v) {
 
 namespace {
 
-std::string num(double v) { return std::isfinite(v) ? yaml::format_double(v) : std::string(); }
-
-struct Table {
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> rows;
-};
-
-Table read_csv(const fs::path& path) {
-  Table t;
-  std::istringstream in(read_text_file(path, "CSV file"));
-  std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    auto cells = split_csv_line(line);
-    if (t.header.empty()) {
-      t.header = std::move(cells);
-      continue;
-    }
-    if (cells.size() != t.header.size())
-      throw UserError(fmt::format("{}:{}: got {} cells, expected {} like the header", path.string(),
-                                  line_no, cells.size(), t.header.size()));
-    t.rows.push_back(std::move(cells));
-  }
-  return t;
-}
-
-double cell_number(const std::string& s) {
-  double v = kNaN;
-  if (s.empty() || !yaml::parse_double(s, &v) || !std::isfinite(v)) return kNaN;
-  return v;
-}
-
-struct Stat {
-  std::size_t n = 0;
-  double mean = kNaN, sd = kNaN, lo = kNaN, hi = kNaN;
-};
-
-Stat stat_of(const std::vector<double>& values) {
-  std::vector<double> v;
-  for (double x : values)
-    if (std::isfinite(x)) v.push_back(x);
-  Stat s;
-  s.n = v.size();
-  if (v.empty()) return s;
-  const eval::Summary sum = eval::summarize(v);
-  s.mean = sum.mean;
-  if (s.n >= 2) {
-    s.sd = sum.sd_sample;
-    std::tie(s.lo, s.hi) = gate::confidence_interval_95(s.mean, s.sd, s.n);
-  }
-  return s;
-}
-
 nlohmann::ordered_json stat_json(const Stat& s) {
   return {{"n", s.n},
           {"mean", finite_or_null(s.mean)},
           {"sd", finite_or_null(s.sd)},
           {"ci95_low", finite_or_null(s.lo)},
           {"ci95_high", finite_or_null(s.hi)}};
-}
-
-std::string file_safe(const std::string& s) {
-  std::string out;
-  for (char c : s)
-    out +=
-        std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' ? c : '_';
-  return out;
 }
 
 }  // namespace
@@ -199,113 +137,6 @@ void require_done_jobs(const SweepManifest& m, const SweepStatus& status, bool a
         fmt::format("{}: no job is done yet, expected at least one finished run "
                     "to merge",
                     m.dir.string()));
-}
-
-// One row of a run's sections.csv in the pool.
-struct PooledSection {
-  std::size_t run;
-  std::map<std::string, std::string> cells;
-};
-
-// Every done run in manifest order, its sections, and the pooled table's columns.
-struct Pool {
-  std::vector<RunData> runs;
-  std::vector<PooledSection> sections;
-  std::vector<std::string> algorithms;  // in order of first appearance
-  std::vector<std::string> header;      // job, point, replicate, seed, axes, run columns
-
-  // A cell of the pooled table: the job's own columns, its parameters, then the run's cells.
-  std::string value_of(const PooledSection& s, const std::string& column) const {
-    const RunData& r = runs[s.run];
-    if (column == "job") return r.job->id;
-    if (column == "point") return std::to_string(r.job->point);
-    if (column == "replicate") return std::to_string(r.job->replicate);
-    if (column == "seed") return std::to_string(r.job->seed);
-    for (const auto& [name, value] : r.job->params)
-      if (name == column) return value;
-    const auto it = s.cells.find(column);
-    return it == s.cells.end() ? std::string() : it->second;
-  }
-  bool is_column(const std::string& c) const {
-    return std::find(header.begin(), header.end(), c) != header.end();
-  }
-  std::string column_list() const {
-    std::string s;
-    for (std::size_t k = 4; k < header.size(); ++k) s += (s.empty() ? "" : ", ") + header[k];
-    return s;
-  }
-  std::vector<const PooledSection*> sections_of(const std::string& algorithm) const {
-    std::vector<const PooledSection*> rows;
-    for (const auto& s : sections) {
-      const auto it = s.cells.find("algorithm");
-      if (it != s.cells.end() && it->second == algorithm) rows.push_back(&s);
-    }
-    return rows;
-  }
-};
-
-RunData read_run(const SweepManifest& m, const SweepJob& job) {
-  RunData rd{&job, {}};
-  const fs::path metrics_file = m.run_dir(job.id) / "metrics.json";
-  std::error_code ec;
-  if (fs::exists(metrics_file, ec)) rd.metrics = record::read_run_record(metrics_file);
-  return rd;
-}
-
-Pool gather_runs(const SweepManifest& m, const SweepStatus& status) {
-  Pool pool;
-  std::vector<std::string> run_columns;  // union of the runs' sections.csv columns
-  for (const auto& st : status.jobs) {
-    if (st.state != JobState::kDone) continue;
-    const SweepJob& job = m.jobs[st.index];
-    const fs::path sections_file = m.run_dir(job.id) / "sections.csv";
-    std::error_code ec;
-    if (fs::exists(sections_file, ec)) {
-      const Table t = read_csv(sections_file);
-      for (const auto& h : t.header) {
-        if (std::find(run_columns.begin(), run_columns.end(), h) == run_columns.end())
-          run_columns.push_back(h);
-        for (const auto& a : m.axes)
-          if (a.name == h)
-            throw UserError(
-                fmt::format("{}: axis name '{}' is also a column of the runs' "
-                            "sections.csv, expected a distinct name (set `name:` "
-                            "on the axis in the sweep file)",
-                            m.dir.string(), h));
-      }
-      for (const auto& row : t.rows) {
-        PooledSection s{pool.runs.size(), {}};
-        for (std::size_t k = 0; k < row.size(); ++k) s.cells[t.header[k]] = row[k];
-        pool.sections.push_back(std::move(s));
-      }
-    }
-    pool.runs.push_back(read_run(m, job));
-  }
-  // Algorithms, in order of first appearance (runs in manifest order, names sorted).
-  auto add_algorithm = [&](const std::string& name) {
-    if (std::find(pool.algorithms.begin(), pool.algorithms.end(), name) == pool.algorithms.end())
-      pool.algorithms.push_back(name);
-  };
-  for (const auto& r : pool.runs)
-    for (const auto& [name, _] : r.metrics.algorithms) add_algorithm(name);
-  for (const auto& s : pool.sections) {
-    const auto it = s.cells.find("algorithm");
-    if (it != s.cells.end()) add_algorithm(it->second);
-  }
-  pool.header = {"job", "point", "replicate", "seed"};
-  for (const auto& a : m.axes) pool.header.push_back(a.name);
-  pool.header.insert(pool.header.end(), run_columns.begin(), run_columns.end());
-  return pool;
-}
-
-std::string pooled_sections_csv(const Pool& pool) {
-  std::string csv = csv_row(pool.header);
-  for (const auto& s : pool.sections) {
-    std::vector<std::string> row;
-    for (const auto& h : pool.header) row.push_back(pool.value_of(s, h));
-    csv += csv_row(row);
-  }
-  return csv;
 }
 
 // The covariates of the pooled regression: --covariates, checked against the pool; by default
@@ -774,147 +605,6 @@ Points per_point(const SweepManifest& m, const Pool& pool) {
   return out;
 }
 
-// gnuplot and its PNG terminal (pngcairo, else libgd's png), or nullopt with a warning.
-std::optional<std::pair<fs::path, std::string>> find_gnuplot(const MergeOptions& o,
-                                                             std::vector<std::string>* warnings) {
-  const std::optional<fs::path> gnuplot =
-      o.gnuplot.empty() ? find_on_path("gnuplot") : std::optional<fs::path>(o.gnuplot);
-  if (!gnuplot) {
-    warnings->push_back("gnuplot not found on PATH: plots skipped (install gnuplot-nox)");
-    return std::nullopt;
-  }
-  ProcessSpec probe{*gnuplot, {"-e", "set terminal pngcairo"}, "/dev/null", {}, true};
-  try {
-    return std::make_pair(*gnuplot, wait_process(spawn_process(probe)).ok() ? "pngcairo" : "png");
-  } catch (const UserError& e) {
-    warnings->push_back(std::string("gnuplot cannot run: plots skipped: ") + e.what());
-    return std::nullopt;
-  }
-}
-
-// An axis's values in order: numeric ascending, else first appearance.
-std::vector<std::string> axis_values(const AxisInfo& a, const Pool& pool) {
-  std::vector<std::string> values;
-  for (const auto& r : pool.runs)
-    for (const auto& [name, value] : r.job->params)
-      if (name == a.name && std::find(values.begin(), values.end(), value) == values.end())
-        values.push_back(value);
-  if (a.numeric)
-    std::stable_sort(values.begin(), values.end(), [](const std::string& x, const std::string& y) {
-      return cell_number(x) < cell_number(y);
-    });
-  return values;
-}
-
-// One plot's data: per algorithm a block of (x, mean, ci95 low, high, runs, label) over the
-// axis values (other axes and replicates pooled); the algorithms that have a block.
-std::pair<std::string, std::vector<std::pair<std::size_t, std::string>>> plot_data(
-    const AxisInfo& a, const std::vector<std::string>& values, const RunMetric& rm,
-    const Pool& pool) {
-  std::string dat = fmt::format(
-      "# {} vs {}: x, mean, ci95_low, ci95_high, runs, label; one "
-      "block per algorithm\n",
-      rm.name, a.name);
-  std::vector<std::pair<std::size_t, std::string>> series;  // block index, algorithm
-  std::size_t block = 0;
-  for (const auto& algo : pool.algorithms) {
-    std::string rows;
-    for (std::size_t k = 0; k < values.size(); ++k) {
-      std::vector<double> v;
-      for (const auto& r : pool.runs)
-        for (const auto& [name, value] : r.job->params)
-          if (name == a.name && value == values[k])
-            v.push_back(run_metric_value(r.metrics, algo, rm));
-      const Stat s = stat_of(v);
-      if (s.n == 0) continue;
-      std::string label = values[k];
-      std::replace(label.begin(), label.end(), '"', '\'');
-      rows += fmt::format("{} {} {} {} {} \"{}\"\n",
-                          a.numeric ? num(cell_number(values[k])) : std::to_string(k), num(s.mean),
-                          num(s.n >= 2 ? s.lo : s.mean), num(s.n >= 2 ? s.hi : s.mean), s.n, label);
-    }
-    if (rows.empty()) continue;
-    dat += fmt::format("# {}\n{}\n\n", algo, rows);
-    series.emplace_back(block++, algo);
-  }
-  return {dat, series};
-}
-
-// The gnuplot script of one plot: series side by side (dodged by a little of the x range) so
-// that their bars do not hide one another.
-std::string plot_script(const AxisInfo& a, const std::vector<std::string>& values,
-                        const RunMetric& rm, const std::string& stem, const std::string& terminal,
-                        const std::vector<std::pair<std::size_t, std::string>>& series) {
-  bool log_x = a.spec == "logspace";
-  for (const auto& v : values) log_x = log_x && a.numeric && cell_number(v) > 0;
-  std::string gp = fmt::format(
-      "# Regenerate with: gnuplot {stem}.gp (in this folder)\n"
-      "set terminal {term} size 900,560 noenhanced\n"
-      "set output '{stem}.png'\n"
-      "set title \"{metric} vs {axis} (mean over runs, 95% CI)\"\n"
-      "set xlabel \"{key}\"\nset ylabel \"{label}\"\n"
-      "set grid\nset key outside right top\nset offsets graph 0.05, graph 0.05, 0, 0\n"
-      "{logx}{xtics}"
-      "plot ",
-      fmt::arg("stem", stem), fmt::arg("term", terminal), fmt::arg("metric", rm.name),
-      fmt::arg("axis", a.name), fmt::arg("key", a.key), fmt::arg("label", rm.label),
-      fmt::arg("logx", log_x ? "set logscale x\n" : ""),
-      fmt::arg("xtics", a.numeric ? "" : "set xtics rotate by -30\n"));
-  double lo = 0, hi = 1;
-  if (a.numeric && !values.empty()) {
-    lo = cell_number(values.front());
-    hi = cell_number(values.back());
-  } else {
-    hi = static_cast<double>(values.size());
-  }
-  const double span = hi > lo ? hi - lo : 1.0;
-  for (std::size_t k = 0; k < series.size(); ++k) {
-    const double shift = (static_cast<double>(k) - (static_cast<double>(series.size()) - 1) / 2);
-    const std::string x = !a.numeric ? fmt::format("($1{:+g})", 0.08 * shift)
-                          : log_x    ? fmt::format("($1*{:g})", std::pow(hi / lo, 0.012 * shift))
-                                     : fmt::format("($1{:+g})", 0.012 * span * shift);
-    gp += fmt::format("{}'{}.dat' index {} using {}:2:3:4{} with yerrorlines title '{}'",
-                      k ? ", \\\n     " : "", stem, series[k].first, x, a.numeric ? "" : ":xtic(6)",
-                      series[k].second);
-  }
-  return gp + "\n";
-}
-
-// Plots: for every axis and run metric the runs have, the marginal mean over all runs at each
-// axis value, with its 95% CI. Returns the summary's image lines.
-std::vector<std::string> draw_plots(const SweepManifest& m, const Pool& pool,
-                                    const std::pair<fs::path, std::string>& gnuplot,
-                                    const fs::path& plots, MergeSummary* out) {
-  std::vector<std::string> plot_md;
-  fs::create_directories(plots);
-  for (const auto& a : m.axes) {
-    const std::vector<std::string> values = axis_values(a, pool);
-    for (const RunMetric& rm : run_metrics()) {
-      const std::string stem = file_safe(a.name) + "__" + rm.name;
-      const auto [dat, series] = plot_data(a, values, rm, pool);
-      if (series.empty()) continue;  // a metric the runs do not have
-      write_file_atomic(plots / (stem + ".dat"), dat);
-      write_file_atomic(plots / (stem + ".gp"),
-                        plot_script(a, values, rm, stem, gnuplot.second, series));
-      const fs::path log = plots / (stem + ".log");
-      ProcessSpec spec{gnuplot.first, {stem + ".gp"}, log, plots, true};
-      const ExitStatus st = wait_process(spawn_process(spec));
-      std::error_code ec;
-      if (st.ok() && fs::exists(plots / (stem + ".png"), ec)) {
-        fs::remove(log, ec);
-        out->plots.push_back("plots/" + stem + ".png");
-        plot_md.push_back(fmt::format("![{} vs {}](plots/{}.png)", rm.name, a.name, stem));
-      } else {
-        out->warnings.push_back(
-            fmt::format("gnuplot failed on plots/{}.gp ({}); see "
-                        "summary/plots/{}.log",
-                        stem, st.describe(), stem));
-      }
-    }
-  }
-  return plot_md;
-}
-
 }  // namespace
 
 MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
@@ -957,8 +647,7 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
   write_file_atomic(dir.path() / "points.csv", points.csv);
   std::vector<std::string> plot_md;
   if (o.plots && !pool.algorithms.empty())
-    if (const auto gnuplot = find_gnuplot(o, &out.warnings))
-      plot_md = draw_plots(m, pool, *gnuplot, dir.path() / "plots", &out);
+    plot_md = draw_sweep_plots(m, pool, o.gnuplot, dir.path() / "plots", &out);
   if (!plot_md.empty()) {
     md += "\n## Plots\n\n";
     for (const auto& p : plot_md) md += p + "\n\n";
