@@ -224,13 +224,11 @@ std::string Evaluation::brief() const {
 
 namespace {
 
-ErrorStats error_stats(const Summary& s) {
-  return {s.n, s.min, s.max, s.mean, s.median, s.rmse, s.std_population};
-}
+CommonStats common_stats(const Summary& s) { return {s.n, s.min, s.max, s.mean, s.median, s.rmse}; }
 
-SampleStats sample_stats(const Summary& s) {
-  return {s.n, s.min, s.max, s.mean, s.median, s.rmse, s.sd_sample};
-}
+ErrorStats error_stats(const Summary& s) { return {common_stats(s), s.std_population}; }
+
+SampleStats sample_stats(const Summary& s) { return {common_stats(s), s.sd_sample}; }
 
 TrackRecord track_record(const TrackErrors& t) {
   return {t.n,          t.rmse_3d_m,   t.max_3d_m,     t.rmse_2d_m,

@@ -18,11 +18,11 @@ namespace driftlab::eval {
 /// it): null in metrics.json, never mistaken for an error of 0.
 inline constexpr double kUnmeasured = std::numeric_limits<double>::quiet_NaN();
 
-/// Statistics of errors over poses or pairs, with the population SD (as evo).
-struct ErrorStats {
+/// What every summary of values reports: count, extremes, mean, median and RMS.
+struct CommonStats {
   std::size_t n = 0;
   double min = kUnmeasured, max = kUnmeasured, mean = kUnmeasured, median = kUnmeasured,
-         rmse = kUnmeasured, sd_population = kUnmeasured;
+         rmse = kUnmeasured;
   template <class A>
   void visit(A& a) {
     a("n", n, "values");
@@ -31,23 +31,25 @@ struct ErrorStats {
     a("mean", mean, "mean");
     a("median", median, "median");
     a("rmse", rmse, "root mean square");
+  }
+};
+
+/// Statistics of errors over poses or pairs, with the population SD (as evo).
+struct ErrorStats : CommonStats {
+  double sd_population = kUnmeasured;
+  template <class A>
+  void visit(A& a) {
+    CommonStats::visit(a);
     a("std", sd_population, "standard deviation of the population (divides by n)");
   }
 };
 
 /// Statistics over sections or runs, with the sample SD (as the papers' tables).
-struct SampleStats {
-  std::size_t n = 0;
-  double min = kUnmeasured, max = kUnmeasured, mean = kUnmeasured, median = kUnmeasured,
-         rmse = kUnmeasured, sd = kUnmeasured;
+struct SampleStats : CommonStats {
+  double sd = kUnmeasured;
   template <class A>
   void visit(A& a) {
-    a("n", n, "values");
-    a("min", min, "smallest");
-    a("max", max, "largest");
-    a("mean", mean, "mean");
-    a("median", median, "median");
-    a("rmse", rmse, "root mean square");
+    CommonStats::visit(a);
     a("sd", sd, "sample standard deviation (divides by n - 1; 0 when n < 2)");
   }
 };

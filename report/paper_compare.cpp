@@ -108,7 +108,7 @@ const AlgorithmRecord& algo(const RunRecord& m, const std::string& a) { return m
 SampleStats covariate(const AlgorithmRecord& a, const char* name) {
   const auto it = a.evaluation.covariates.find(name);
   if (it != a.evaluation.covariates.end()) return it->second;
-  return {0, kNa, kNa, kNa, kNa, kNa, kNa};
+  return {{0, kNa, kNa, kNa, kNa, kNa}, kNa};
 }
 
 // A regression term's coefficient, NaN where the regression did not fit it.
