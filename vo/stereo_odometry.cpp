@@ -25,7 +25,7 @@ SE3 accumulate_pose(const SE3& T_world_prev, const VoResult& result) {
   return result.valid ? T_world_prev * result.T_prev_curr : T_world_prev;
 }
 
-namespace detail {
+namespace {
 
 void check_image(const cv::Mat& image, const PinholeCamera& camera, const char* who,
                  const char* which) {
@@ -36,6 +36,17 @@ void check_image(const cv::Mat& image, const PinholeCamera& camera, const char* 
                     ", expected " + std::to_string(camera.width) + "x" +
                     std::to_string(camera.height) + " CV_8UC1");
   }
+}
+
+}  // namespace
+
+namespace detail {
+
+SteadyClock::time_point begin_frame(const StereoFrame& frame, const PinholeCamera& camera,
+                                    const char* who) {
+  check_image(frame.left, camera, who, "left");
+  check_image(frame.right, camera, who, "right");
+  return SteadyClock::now();
 }
 
 bool is_finite(const SE3& T) {

@@ -104,10 +104,11 @@ SE3 accumulate_pose(const SE3& T_world_prev, const VoResult& result);
 
 /// Helpers every implementation shares.
 namespace detail {
-/// Throws UserError unless `image` is a CV_8UC1 image of the camera's size;
-/// `who` and `which` ("left"/"right") name it in the message.
-void check_image(const cv::Mat& image, const PinholeCamera& camera, const char* who,
-                 const char* which);
+/// The start of a process() call: throws UserError unless both images of `frame` are CV_8UC1
+/// images of the camera's size (`who`, the VO, and the image named in the message), and returns
+/// the time the call's total is counted from.
+SteadyClock::time_point begin_frame(const StereoFrame& frame, const PinholeCamera& camera,
+                                    const char* who);
 /// True when every number of T is finite.
 bool is_finite(const SE3& T);
 /// The end of a process() call without a motion: `result` invalid for `reason`, with the

@@ -188,9 +188,7 @@ void DenseStereoOdometry::reset() {
 
 VoResult DenseStereoOdometry::process(const StereoFrame& frame) {
   Impl& s = *impl_;
-  detail::check_image(frame.left, s.rig.camera, "DenseStereoOdometry", "left");
-  detail::check_image(frame.right, s.rig.camera, "DenseStereoOdometry", "right");
-  const auto t_start = SteadyClock::now();
+  const auto t_start = detail::begin_frame(frame, s.rig.camera, "DenseStereoOdometry");
   VoResult result;
   s.stats = {};
   Impl::FrameData& cur = *s.cur;

@@ -268,9 +268,7 @@ void PnpStereoOdometry::reset() {
 
 VoResult PnpStereoOdometry::process(const StereoFrame& frame) {
   Impl& s = *impl_;
-  detail::check_image(frame.left, s.rig.camera, "PnpStereoOdometry", "left");
-  detail::check_image(frame.right, s.rig.camera, "PnpStereoOdometry", "right");
-  const auto t_start = SteadyClock::now();
+  const auto t_start = detail::begin_frame(frame, s.rig.camera, "PnpStereoOdometry");
   VoResult result;
   s.stats = {};
 

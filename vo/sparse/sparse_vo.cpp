@@ -289,9 +289,7 @@ void SparseStereoOdometry::reset() {
 
 VoResult SparseStereoOdometry::process(const StereoFrame& frame) {
   Impl& s = *impl_;
-  detail::check_image(frame.left, s.rig.camera, "SparseStereoOdometry", "left");
-  detail::check_image(frame.right, s.rig.camera, "SparseStereoOdometry", "right");
-  const auto t_start = SteadyClock::now();
+  const auto t_start = detail::begin_frame(frame, s.rig.camera, "SparseStereoOdometry");
   VoResult result;
   s.circles.clear();
   s.infos.clear();
