@@ -73,7 +73,7 @@ CsvTable read_csv_table(std::string_view text, const std::string& source,
       t.header_line = line_no;
       continue;
     }
-    if (cells.size() != t.header.size())
+    if (!options.ragged && cells.size() != t.header.size())
       throw UserError(fmt::format("{}:{}: got {} cells, expected {} like the header", source,
                                   line_no, cells.size(), t.header.size()));
     t.rows.push_back({line_no, std::move(cells)});

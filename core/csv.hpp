@@ -33,12 +33,13 @@ struct CsvTable {
 struct CsvTableOptions {
   CsvTrim trim = CsvTrim::kNo;
   bool comments = false;  ///< skip lines whose first character is '#'
+  bool ragged = false;    ///< keep rows of another length than the header (the reader checks)
 };
 
 /// Reads CSV text whose first line (after blank lines, and comments when asked) is the header.
 /// Blank lines are skipped; every row must have as many cells as the header, else UserError
-/// "SOURCE:LINE: got N cells, expected M like the header". Text without a header line gives an
-/// empty table (header_line 0).
+/// "SOURCE:LINE: got N cells, expected M like the header" (unless `ragged`). Text without a header
+/// line gives an empty table (header_line 0).
 CsvTable read_csv_table(std::string_view text, const std::string& source,
                         const CsvTableOptions& options = {});
 

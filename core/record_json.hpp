@@ -36,6 +36,7 @@
 #include <set>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "core/error.hpp"
@@ -116,6 +117,10 @@ nlohmann::json Writer::value_json(const T& value, const std::string& at,
   }
 }
 
+/// Whether `A` is the writer: for a part a record leaves out of what it writes when unset.
+template <class A>
+inline constexpr bool is_writer = std::is_same_v<A, Writer>;
+
 /// The record as JSON; each number written as null is added to `nonfinite` when given.
 template <yaml::Visitable T>
 nlohmann::json to_json(const T& record, std::vector<NonFinite>* nonfinite = nullptr) {
@@ -181,7 +186,11 @@ template <class T>
 void Reader::read(const nlohmann::json& j, const std::string& at, T* value) const {
   if constexpr (yaml::is_std_optional<T>::value) {
     if (j.is_null()) {
-      value->reset();
+      // A number written as null was there but not finite; anything else null is absent.
+      if constexpr (std::is_floating_point_v<typename T::value_type>)
+        *value = std::numeric_limits<typename T::value_type>::quiet_NaN();
+      else
+        value->reset();
       return;
     }
     typename T::value_type inner{};
@@ -200,9 +209,15 @@ void Reader::read(const nlohmann::json& j, const std::string& at, T* value) cons
     if (!j.is_boolean()) fail(j, at, expected<T>());
     *value = j.get<bool>();
   } else if constexpr (std::is_integral_v<T>) {
-    const bool ok = j.is_number_integer() && (!std::is_unsigned_v<T> || j.is_number_unsigned() ||
-                                              j.get<std::int64_t>() >= 0);
-    if (!ok) fail(j, at, expected<T>());
+    if (!j.is_number_integer() ||
+        (std::is_unsigned_v<T> && !j.is_number_unsigned() && j.get<std::int64_t>() < 0))
+      fail(j, at, expected<T>());
+    const bool fits = j.is_number_unsigned() ? std::in_range<T>(j.get<std::uint64_t>())
+                                             : std::in_range<T>(j.get<std::int64_t>());
+    if (!fits)
+      fail(j, at,
+           expected<T>() + " from " + std::to_string(std::numeric_limits<T>::min()) + " to " +
+               std::to_string(std::numeric_limits<T>::max()));
     *value = j.get<T>();
   } else if constexpr (std::is_same_v<T, std::string>) {
     if (!j.is_string()) fail(j, at, expected<T>());

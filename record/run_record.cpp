@@ -36,7 +36,7 @@ RunRecord read_run_record(const std::filesystem::path& path) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // syntax, and numbers past double's range
     throw UserError(
         fmt::format("{}: not valid JSON ({}), expected a run's metrics", file.string(), e.what()));
   }

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/record_json.hpp"
 #include "eval/evaluation_record.hpp"
 
 namespace driftlab::record {
@@ -79,7 +80,9 @@ struct AlgorithmRecord {
   std::optional<VsRawVoRecord> vs_raw_vo;
   template <class A>
   void visit(A& a) {
-    evaluation.visit(a);
+    // A track never evaluated (a filter on a dataset without ground truth) is written without
+    // the evaluation's keys; the reader and the reference see them all.
+    if (!record_json::is_writer<A> || !evaluation.algorithm.empty()) evaluation.visit(a);
     a("tracking", tracking,
       "where a VO lost track: its frames without a motion estimate, by reason, and each stretch "
       "of them (a stretch of a second or more is a warning)");

@@ -70,11 +70,14 @@ struct SectionRows {
 
 SectionRows split_sections(const std::string& sections_csv) {
   SectionRows out;
-  const CsvTable t = read_csv_table(sections_csv, "sections.csv");
+  // The rows of a track whose covariates the first track lacks are longer than the header:
+  // left out of the plots, as before.
+  const CsvTable t = read_csv_table(sections_csv, "sections.csv", {.ragged = true});
   const std::vector<std::string> cov_names = {"v", "h", "f", "d"};
   const auto c_alg = t.column("algorithm"), c_p = t.column("p_m_per_m");
   if (!c_alg || !c_p) return out;
   for (const CsvTable::Row& r : t.rows) {
+    if (r.cells.size() != t.header.size()) continue;
     const std::string& alg = r.cells[*c_alg];
     if (!out.rows.count(alg)) out.order.push_back(alg);
     std::string row = r.cells[*c_p];

@@ -133,9 +133,9 @@ std::vector<std::string> draw_sweep_plots(const SweepManifest& m, const Pool& po
         plot_md.push_back(fmt::format("![{} vs {}](plots/{}.png)", rm.name, a.name, stem));
       } else {
         out->warnings.push_back(
-            fmt::format("gnuplot failed on plots/{}.gp ({}); see "
-                        "summary/plots/{}.log",
-                        stem, run.ok ? "no image" : run.failure, stem));
+            run.ok ? fmt::format("gnuplot drew no image from plots/{}.gp", stem)
+                   : fmt::format("gnuplot failed on plots/{}.gp ({}); see summary/plots/{}.log",
+                                 stem, run.failure, stem));
       }
     }
   }

@@ -111,6 +111,27 @@ TEST(RecordJson, NamesEachNumberWrittenAsNullAndReadsNullAsNaN) {
   EXPECT_TRUE(std::isnan(back.by_name.at("a").x));  // null: not a number any more
 }
 
+// A number written as null (not finite) in an optional stays there: read back as NaN, written
+// again as null.
+struct RjMaybeNumber {
+  std::optional<double> r2;
+  template <class A>
+  void visit(A& a) {
+    a("r2", r2, "R^2");
+  }
+};
+
+TEST(RecordJson, AnOptionalNumberWrittenAsNullReadsBackAsNaN) {
+  RjMaybeNumber r;
+  r.r2 = std::numeric_limits<double>::quiet_NaN();
+  const nlohmann::json j = to_json(r);
+  EXPECT_EQ(j.dump(), R"({"r2":null})");
+  const auto back = from_json<RjMaybeNumber>(j, "m.json");
+  ASSERT_TRUE(back.r2.has_value());
+  EXPECT_TRUE(std::isnan(*back.r2));
+  EXPECT_EQ(to_json(back).dump(), j.dump());
+}
+
 TEST(RecordJson, KeepsDefaultsForAbsentKeysAndReadsNullOptionalsAsEmpty) {
   const auto r =
       from_json<RjRecord>(nlohmann::json::parse(R"({"name": "x", "maybe": null})"), "old.json");
@@ -139,6 +160,9 @@ TEST(RecordJson, RefusesWrongTypesAndUnknownKeysNamingFileKeyValueAndExpectation
             "run/metrics.json: pair: got [1], expected a list of 2");
   EXPECT_EQ(read_error(R"({"by_name": {"a": {"x": 1, "y": 2}}})"),
             "run/metrics.json: by_name.a.y: unknown key, expected one of: values, x");
+  EXPECT_EQ(read_error(R"({"offset": 9223372036854775808})"),
+            "run/metrics.json: offset: got 9223372036854775808, expected a whole number from "
+            "-9223372036854775808 to 9223372036854775807");
   EXPECT_EQ(read_error(R"({"flag": 1})"), "run/metrics.json: flag: got 1, expected true or false");
 }
 

@@ -66,5 +66,15 @@ TEST(RunRecord, WritesWhatItReadsByteForByte) {
   EXPECT_TRUE(std::isnan(back.sensors->gps->mean_hdop_with_fix));
 }
 
+// A track never evaluated (a filter on a dataset without ground truth) keeps only what it has.
+TEST(RunRecord, ATrackNeverEvaluatedIsWrittenWithoutEvaluationKeys) {
+  RunRecord r;
+  r.algorithms["sparse_ca"].filter = std::map<std::string, std::int64_t>{{"nonfinite_guards", 0}};
+  const nlohmann::json j = nlohmann::json::parse(metrics_text(r));
+  EXPECT_EQ(j["algorithms"]["sparse_ca"].dump(), R"({"filter":{"nonfinite_guards":0}})");
+  const RunRecord back = run_record_from_json(j, "m.json");
+  EXPECT_EQ(metrics_text(back), metrics_text(r));
+}
+
 }  // namespace
 }  // namespace driftlab::record
