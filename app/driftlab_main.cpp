@@ -33,6 +33,7 @@
 #include "pipeline/scenario.hpp"
 #include "pipeline/scenario_checks.hpp"
 #include "record/run_record.hpp"
+#include "study/sweep_records.hpp"
 
 #ifndef DRIFTLAB_VERSION
 #define DRIFTLAB_VERSION "unknown"
@@ -224,12 +225,14 @@ struct MetricsVerbs : Pinned {
     if (!schema_cmd->parsed()) return std::nullopt;
     return driftlab::app::print_reference(
         "Metrics reference", "driftlab metrics schema",
-        "Every key of a run's metrics.json (`driftlab run`, `driftlab vo`), with its type and "
-        "meaning. NAME stands for a name the run chose (a track, a covariate, a reason), [] for "
-        "each element of a list. A number that could not be computed is null, and the run's "
-        "warnings name it. A file without `metrics_version` is version 1 (the same keys); a "
-        "newer version than this driftlab's is refused.",
-        driftlab::record::metrics_reference_markdown(), schema_out);
+        "Every key of a run's metrics.json (`driftlab run`, `driftlab vo`) and of a sweep "
+        "folder's files, with its type and meaning. NAME stands for a name the run chose (a "
+        "track, a covariate, a reason), [] for each element of a list. A number that could not "
+        "be computed is null, and the run's warnings name it. A file without `metrics_version` "
+        "is version 1 (the same keys); a newer version than this driftlab's is refused.",
+        "## A run's metrics.json\n\n" + driftlab::record::metrics_reference_markdown() +
+            driftlab::study::sweep_files_reference_markdown(),
+        schema_out);
   }
 
   CLI::App* schema_cmd = nullptr;

@@ -6,15 +6,17 @@
 
 namespace driftlab::record_json {
 
-void Reader::fail(const nlohmann::json& j, const std::string& at,
-                  const std::string& expected) const {
+template <class Json>
+void BasicReader<Json>::fail(const Json& j, const std::string& at,
+                             const std::string& expected) const {
   std::string value = j.dump();
   if (value.size() > 60) value = value.substr(0, 57) + "...";
   throw UserError(fmt::format("{}: {}: got {}, expected {}", source_, at.empty() ? "(top)" : at,
                               value, expected));
 }
 
-void Reader::reject_unknown_keys() const {
+template <class Json>
+void BasicReader<Json>::reject_unknown_keys() const {
   for (const auto& [key, _] : in_.items()) {
     if (seen_.count(key)) continue;
     std::string known;
@@ -23,6 +25,9 @@ void Reader::reject_unknown_keys() const {
                                 prefix_.empty() ? key : prefix_ + "." + key, known));
   }
 }
+
+template class BasicReader<nlohmann::json>;  // the two JSON types from_json accepts
+template class BasicReader<nlohmann::ordered_json>;
 
 std::string fields_markdown(const std::vector<FieldRow>& rows) {
   std::string out = "| key | type | meaning |\n|---|---|---|\n";

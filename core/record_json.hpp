@@ -19,10 +19,14 @@
 //
 // Field types: bool, integers, double, std::string, enums with an ADL `enum_table` (by
 // name), nested records, std::vector<T>, std::array<T, N>, std::map<std::string, T> (an
-// object of names of the run's choosing), std::optional<T> (absent when empty; null reads as
-// empty) and
-// nlohmann::json (any JSON, kept as it is). A double that is not finite is written as null,
-// and the writer names it; null reads back as NaN.
+// object of names of the run's choosing), Named<T> (the same, its names in the order they
+// were added), std::optional<T> (absent when empty; null reads as empty) and nlohmann::json
+// (any JSON, kept as it is). A double that is not finite is written as null, and the writer
+// names it; null reads back as NaN.
+//
+// to_json writes objects with their keys sorted (nlohmann::json); to_ordered_json keeps the
+// order of the visit() lists and of Named<T> (nlohmann::ordered_json), for files a person reads
+// top to bottom.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -49,6 +53,34 @@ struct is_string_map : std::false_type {};
 template <class T, class Cmp, class Alloc>
 struct is_string_map<std::map<std::string, T, Cmp, Alloc>> : std::true_type {};
 
+/// An object of names chosen at run time, kept in the order they were added: a JSON object
+/// whose keys keep their order under to_ordered_json.
+template <class T>
+struct Named {
+  std::vector<std::pair<std::string, T>> items;
+
+  /// The value under `name`, added (default) at the end when absent.
+  T& operator[](const std::string& name) {
+    for (auto& [n, v] : items)
+      if (n == name) return v;
+    return items.emplace_back(name, T{}).second;
+  }
+  const T* find(const std::string& name) const {
+    for (const auto& [n, v] : items)
+      if (n == name) return &v;
+    return nullptr;
+  }
+  bool empty() const { return items.empty(); }
+  std::size_t size() const { return items.size(); }
+  auto begin() const { return items.begin(); }
+  auto end() const { return items.end(); }
+};
+
+template <class T>
+struct is_named : std::false_type {};
+template <class T>
+struct is_named<Named<T>> : std::true_type {};
+
 /// A number the writer wrote as null, by its key path ("ape.trans_m.rmse").
 struct NonFinite {
   std::string key;
@@ -56,11 +88,13 @@ struct NonFinite {
 };
 
 // ---------------------------------------------------------------------------
-// Writer: every field, under its key; nlohmann's objects keep their keys sorted.
+// Writer: every field, under its key; Json is nlohmann::json (keys sorted) or
+// nlohmann::ordered_json (keys in the order written).
 
-class Writer : public yaml::IgnoresRules {
+template <class Json>
+class BasicWriter : public yaml::IgnoresRules {
  public:
-  Writer(nlohmann::json* out, std::string prefix, std::vector<NonFinite>* nonfinite)
+  BasicWriter(Json* out, std::string prefix, std::vector<NonFinite>* nonfinite)
       : out_(out), prefix_(std::move(prefix)), nonfinite_(nonfinite) {}
 
   template <class T>
@@ -72,43 +106,43 @@ class Writer : public yaml::IgnoresRules {
   }
 
   template <class T>
-  static nlohmann::json value_json(const T& value, const std::string& at,
-                                   std::vector<NonFinite>* nonfinite);
+  static Json value_json(const T& value, const std::string& at, std::vector<NonFinite>* nonfinite);
 
  private:
   std::string path(const char* key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
 
-  nlohmann::json* out_;
+  Json* out_;
   std::string prefix_;
   std::vector<NonFinite>* nonfinite_;
 };
 
+template <class Json>
 template <class T>
-nlohmann::json Writer::value_json(const T& value, const std::string& at,
-                                  std::vector<NonFinite>* nonfinite) {
+Json BasicWriter<Json>::value_json(const T& value, const std::string& at,
+                                   std::vector<NonFinite>* nonfinite) {
   if constexpr (yaml::is_std_optional<T>::value) {
-    return value ? value_json(*value, at, nonfinite) : nlohmann::json();
+    return value ? value_json(*value, at, nonfinite) : Json();
   } else if constexpr (std::is_same_v<T, nlohmann::json>) {
-    return value;
+    return Json(value);
   } else if constexpr (std::is_same_v<T, double>) {
     if (!std::isfinite(value) && nonfinite) nonfinite->push_back({at, value});
-    return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
+    return std::isfinite(value) ? Json(value) : Json();
   } else if constexpr (std::is_same_v<T, bool> || std::is_integral_v<T> ||
                        std::is_same_v<T, std::string>) {
     return value;
   } else if constexpr (yaml::Enum<T>) {
     return std::string(yaml::enum_name(value));
   } else if constexpr (yaml::Visitable<T>) {
-    nlohmann::json j = nlohmann::json::object();
-    Writer sub(&j, at, nonfinite);
+    Json j = Json::object();
+    BasicWriter sub(&j, at, nonfinite);
     const_cast<T&>(value).visit(sub);  // the writer only reads the fields
     return j;
-  } else if constexpr (is_string_map<T>::value) {
-    nlohmann::json j = nlohmann::json::object();
+  } else if constexpr (is_string_map<T>::value || is_named<T>::value) {
+    Json j = Json::object();
     for (const auto& [name, v] : value) j[name] = value_json(v, at + "." + name, nonfinite);
     return j;
   } else if constexpr (yaml::is_std_vector<T>::value || yaml::is_std_array<T>::value) {
-    nlohmann::json j = nlohmann::json::array();
+    Json j = Json::array();
     for (std::size_t i = 0; i < value.size(); ++i)
       j.push_back(value_json(value[i], at + "[" + std::to_string(i) + "]", nonfinite));
     return j;
@@ -117,24 +151,41 @@ nlohmann::json Writer::value_json(const T& value, const std::string& at,
   }
 }
 
+using Writer = BasicWriter<nlohmann::json>;
+using OrderedWriter = BasicWriter<nlohmann::ordered_json>;
+
 /// Whether `A` is the writer: for a part a record leaves out of what it writes when unset.
 template <class A>
-inline constexpr bool is_writer = std::is_same_v<A, Writer>;
+inline constexpr bool is_writer = std::is_same_v<A, Writer> || std::is_same_v<A, OrderedWriter>;
 
-/// The record as JSON; each number written as null is added to `nonfinite` when given.
+/// The record as JSON, keys sorted; each number written as null is added to `nonfinite` when
+/// given.
 template <yaml::Visitable T>
 nlohmann::json to_json(const T& record, std::vector<NonFinite>* nonfinite = nullptr) {
   return Writer::value_json(record, "", nonfinite);
 }
 
+/// The record as JSON, keys in the order of its visit() lists and Named<T>s.
+template <yaml::Visitable T>
+nlohmann::ordered_json to_ordered_json(const T& record,
+                                       std::vector<NonFinite>* nonfinite = nullptr) {
+  return OrderedWriter::value_json(record, "", nonfinite);
+}
+
 // ---------------------------------------------------------------------------
 // Reader: strict on types and keys; an absent key keeps the field's default (an older file
-// without a newer block), an absent optional stays empty.
+// without a newer block), an absent optional stays empty. Json is nlohmann::json or
+// nlohmann::ordered_json (a Named<T> then reads in the file's order).
 
-class Reader : public yaml::IgnoresRules {
+template <class Json>
+class BasicReader : public yaml::IgnoresRules {
  public:
-  Reader(const nlohmann::json& in, std::string source, std::string prefix)
-      : in_(in), source_(std::move(source)), prefix_(std::move(prefix)) {}
+  BasicReader(const Json& in, std::string source, std::string prefix,
+              bool ignore_unknown_keys = false)
+      : in_(in),
+        source_(std::move(source)),
+        prefix_(std::move(prefix)),
+        ignore_unknown_keys_(ignore_unknown_keys) {}
 
   template <class T>
   void operator()(const char* key, T& value, const char*, const yaml::Check& = {}) {
@@ -147,22 +198,23 @@ class Reader : public yaml::IgnoresRules {
   void reject_unknown_keys() const;
 
   template <class T>
-  void read(const nlohmann::json& j, const std::string& at, T* value) const;
+  void read(const Json& j, const std::string& at, T* value) const;
 
  private:
   std::string path(const char* key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
-  [[noreturn]] void fail(const nlohmann::json& j, const std::string& at,
-                         const std::string& expected) const;
+  [[noreturn]] void fail(const Json& j, const std::string& at, const std::string& expected) const;
   template <class T>
   static std::string expected();
 
-  const nlohmann::json& in_;
+  const Json& in_;
   std::string source_, prefix_;
+  bool ignore_unknown_keys_;
   std::set<std::string> seen_;
 };
 
+template <class Json>
 template <class T>
-std::string Reader::expected() {
+std::string BasicReader<Json>::expected() {
   if constexpr (std::is_same_v<T, double>) {
     return "a number or null";
   } else if constexpr (std::is_same_v<T, bool>) {
@@ -175,15 +227,16 @@ std::string Reader::expected() {
     return "a string";
   } else if constexpr (yaml::Enum<T>) {
     return "one of " + yaml::enum_choices<T>();
-  } else if constexpr (yaml::Visitable<T> || is_string_map<T>::value) {
+  } else if constexpr (yaml::Visitable<T> || is_string_map<T>::value || is_named<T>::value) {
     return "an object";
   } else {
     return "a list";
   }
 }
 
+template <class Json>
 template <class T>
-void Reader::read(const nlohmann::json& j, const std::string& at, T* value) const {
+void BasicReader<Json>::read(const Json& j, const std::string& at, T* value) const {
   if constexpr (yaml::is_std_optional<T>::value) {
     if (j.is_null()) {
       // A number written as null was there but not finite; anything else null is absent.
@@ -197,43 +250,44 @@ void Reader::read(const nlohmann::json& j, const std::string& at, T* value) cons
     read(j, at, &inner);
     *value = std::move(inner);
   } else if constexpr (std::is_same_v<T, nlohmann::json>) {
-    *value = j;
+    *value = nlohmann::json(j);
   } else if constexpr (std::is_same_v<T, double>) {
     if (j.is_null()) {
       *value = std::numeric_limits<double>::quiet_NaN();
     } else {
       if (!j.is_number()) fail(j, at, expected<T>());
-      *value = j.get<double>();
+      *value = j.template get<double>();
     }
   } else if constexpr (std::is_same_v<T, bool>) {
     if (!j.is_boolean()) fail(j, at, expected<T>());
-    *value = j.get<bool>();
+    *value = j.template get<bool>();
   } else if constexpr (std::is_integral_v<T>) {
     if (!j.is_number_integer() ||
-        (std::is_unsigned_v<T> && !j.is_number_unsigned() && j.get<std::int64_t>() < 0))
+        (std::is_unsigned_v<T> && !j.is_number_unsigned() && j.template get<std::int64_t>() < 0))
       fail(j, at, expected<T>());
-    const bool fits = j.is_number_unsigned() ? std::in_range<T>(j.get<std::uint64_t>())
-                                             : std::in_range<T>(j.get<std::int64_t>());
+    const bool fits = j.is_number_unsigned() ? std::in_range<T>(j.template get<std::uint64_t>())
+                                             : std::in_range<T>(j.template get<std::int64_t>());
     if (!fits)
       fail(j, at,
            expected<T>() + " from " + std::to_string(std::numeric_limits<T>::min()) + " to " +
                std::to_string(std::numeric_limits<T>::max()));
-    *value = j.get<T>();
+    *value = j.template get<T>();
   } else if constexpr (std::is_same_v<T, std::string>) {
     if (!j.is_string()) fail(j, at, expected<T>());
-    *value = j.get<std::string>();
+    *value = j.template get<std::string>();
   } else if constexpr (yaml::Enum<T>) {
-    const auto e = j.is_string() ? yaml::enum_from_name<T>(j.get<std::string>()) : std::nullopt;
+    const auto e =
+        j.is_string() ? yaml::enum_from_name<T>(j.template get<std::string>()) : std::nullopt;
     if (!e) fail(j, at, expected<T>());
     *value = *e;
   } else if constexpr (yaml::Visitable<T>) {
     if (!j.is_object()) fail(j, at, expected<T>());
-    Reader sub(j, source_, at);
+    BasicReader sub(j, source_, at, ignore_unknown_keys_);
     value->visit(sub);
-    sub.reject_unknown_keys();
-  } else if constexpr (is_string_map<T>::value) {
+    if (!ignore_unknown_keys_) sub.reject_unknown_keys();
+  } else if constexpr (is_string_map<T>::value || is_named<T>::value) {
     if (!j.is_object()) fail(j, at, expected<T>());
-    value->clear();
+    *value = T{};
     for (const auto& [name, v] : j.items()) read(v, at + "." + name, &(*value)[name]);
   } else if constexpr (yaml::is_std_vector<T>::value) {
     if (!j.is_array()) fail(j, at, expected<T>());
@@ -250,12 +304,54 @@ void Reader::read(const nlohmann::json& j, const std::string& at, T* value) cons
   }
 }
 
-/// Reads a record written by to_json; `source` names the file in errors. Throws UserError.
-template <yaml::Visitable T>
-T from_json(const nlohmann::json& j, const std::string& source) {
+using Reader = BasicReader<nlohmann::json>;
+using OrderedReader = BasicReader<nlohmann::ordered_json>;
+
+/// Whether an unknown key is an error, or left for a newer writer's reader.
+enum class UnknownKeys { kReject, kIgnore };
+
+/// Reads a record written by to_json or to_ordered_json; `source` names the file in errors.
+/// Throws UserError.
+template <yaml::Visitable T, class Json>
+requires std::is_same_v<Json, nlohmann::json> || std::is_same_v<Json, nlohmann::ordered_json> T
+from_json(const Json& j, const std::string& source, UnknownKeys unknown = UnknownKeys::kReject) {
   T record{};
-  Reader(j, source, "").read(j, "", &record);
+  BasicReader<Json>(j, source, "", unknown == UnknownKeys::kIgnore).read(j, "", &record);
   return record;
+}
+
+/// The top-level keys of a visit() list, in order.
+class KeyLister : public yaml::IgnoresRules {
+ public:
+  template <class V>
+  void operator()(const char* key, V&, const char*, const yaml::Check& = {}) {
+    keys.push_back(key);
+  }
+  std::vector<std::string> keys;
+};
+
+/// The keys of T's visit() list that the object `j` lacks, in that order (all of them when `j`
+/// is not an object): for files whose every key is required.
+template <yaml::Visitable T, class Json>
+std::vector<std::string> missing_keys(const Json& j) {
+  KeyLister lister;
+  T{}.visit(lister);
+  std::vector<std::string> missing;
+  for (const auto& k : lister.keys)
+    if (!j.is_object() || !j.contains(k)) missing.push_back(k);
+  return missing;
+}
+
+/// `text` parsed as JSON (Json: nlohmann::ordered_json keeps the file's key order); anything
+/// malformed, or a number past a double's range, is a UserError naming `source` and what was
+/// `expected`.
+template <class Json = nlohmann::ordered_json>
+Json parse_json(const std::string& text, const std::string& source, const std::string& expected) {
+  try {
+    return Json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw UserError(source + ": not valid JSON (" + e.what() + "), expected " + expected);
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -282,6 +378,8 @@ class Documenter : public yaml::IgnoresRules {
   void add(const std::string& at, const char* doc, bool optional);
   template <class T>
   static std::string type_name();
+  template <class T>
+  void add_named_value(const std::string& at);
 
   std::string prefix_;
   std::vector<FieldRow>* rows_;
@@ -305,6 +403,9 @@ std::string Documenter::type_name() {
     return "object";
   } else if constexpr (is_string_map<T>::value) {
     return "object of names to " + type_name<typename T::mapped_type>();
+  } else if constexpr (is_named<T>::value) {
+    return "object of names (in order) to " +
+           type_name<typename decltype(T::items)::value_type::second_type>();
   } else if constexpr (yaml::is_std_array<T>::value) {
     return "list of " + std::to_string(std::tuple_size_v<T>) + " " +
            type_name<typename T::value_type>();
@@ -324,12 +425,8 @@ void Documenter::add(const std::string& at, const char* doc, bool optional) {
     if constexpr (yaml::Visitable<T>) {
       Documenter sub(at, rows_);
       T{}.visit(sub);
-    } else if constexpr (is_string_map<T>::value) {
-      using V = typename T::mapped_type;
-      if constexpr (yaml::Visitable<V>) {
-        Documenter sub(at + ".NAME", rows_);
-        V{}.visit(sub);
-      }
+    } else if constexpr (is_string_map<T>::value || is_named<T>::value) {
+      add_named_value<T>(at);
     } else if constexpr (yaml::is_std_vector<T>::value || yaml::is_std_array<T>::value) {
       using V = typename T::value_type;
       if constexpr (yaml::Visitable<V>) {
@@ -337,6 +434,18 @@ void Documenter::add(const std::string& at, const char* doc, bool optional) {
         V{}.visit(sub);
       }
     }
+  }
+}
+
+// The fields of the values of an object of names, under NAME (a Named of Named: NAME.NAME).
+template <class T>
+void Documenter::add_named_value(const std::string& at) {
+  using V = typename decltype(std::declval<T>().begin())::value_type::second_type;
+  if constexpr (yaml::Visitable<V>) {
+    Documenter sub(at + ".NAME", rows_);
+    V{}.visit(sub);
+  } else if constexpr (is_string_map<V>::value || is_named<V>::value) {
+    add_named_value<V>(at + ".NAME");
   }
 }
 

@@ -33,13 +33,7 @@ RunRecord read_run_record(const std::filesystem::path& path) {
   const std::filesystem::path file =
       std::filesystem::is_directory(path) ? path / "metrics.json" : path;
   const std::string text = read_text_file(file, "run metrics");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {  // syntax, and numbers past double's range
-    throw UserError(
-        fmt::format("{}: not valid JSON ({}), expected a run's metrics", file.string(), e.what()));
-  }
+  const auto j = record_json::parse_json<nlohmann::json>(text, file.string(), "a run's metrics");
   return run_record_from_json(j, file.string());
 }
 

@@ -110,30 +110,19 @@ double json_number(const nlohmann::json& j, const std::string& dotted) {
   return node->is_number() ? node->get<double>() : std::numeric_limits<double>::quiet_NaN();
 }
 
-// An OLS fit into metrics.json (n, R^2, F, each coefficient) and summary.md (a table and
-// the fit's paragraph).
-void append_ols(const eval::OlsResult& r, nlohmann::ordered_json* j, std::string* md) {
-  (*j)["n"] = r.n;
-  (*j)["r2"] = finite_or_null(r.r2);
-  (*j)["adj_r2"] = finite_or_null(r.adj_r2);
-  (*j)["f"] = finite_or_null(r.f);
-  (*j)["f_p"] = finite_or_null(r.f_p);
-  (*j)["sigma"] = finite_or_null(r.sigma);
-  (*j)["coefficients"] = nlohmann::ordered_json::object();
+// An OLS fit as metrics.json holds it, and its part of summary.md (a table and the fit's
+// paragraph).
+OlsFitRecord ols_record(const eval::OlsResult& r, std::string* md) {
+  OlsFitRecord out{r.n, r.r2, r.adj_r2, r.f, r.f_p, r.sigma, {}, r.warnings, std::nullopt};
   *md += "| term | estimate | std. error | t | p | VIF |\n|---|---|---|---|---|---|\n";
   for (const auto& c : r.coefficients) {
-    (*j)["coefficients"][c.name] = {{"estimate", finite_or_null(c.estimate)},
-                                    {"std_error", finite_or_null(c.std_error)},
-                                    {"t", finite_or_null(c.t)},
-                                    {"p", finite_or_null(c.p)},
-                                    {"vif", finite_or_null(c.vif)},
-                                    {"significant", c.significant}};
+    out.coefficients[c.name] = {c.estimate, c.std_error, c.t, c.p, c.vif, c.significant};
     *md += fmt::format("| {}{} | {:.4g} | {:.3g} | {:.3g} | {:.3g} | {} |\n", c.name,
                        c.significant ? " *" : "", c.estimate, c.std_error, c.t, c.p,
                        c.name == "Intercept" ? std::string("") : fmt::format("{:.3g}", c.vif));
   }
-  (*j)["warnings"] = r.warnings;
   *md += "\n" + r.brief() + "\n";
+  return out;
 }
 
 std::vector<RunRegression> parse_run_regressions(const std::vector<std::string>& specs,
@@ -170,9 +159,10 @@ std::vector<RunRegression> parse_run_regressions(const std::vector<std::string>&
 }
 
 // Fits each --regress over the runs of `algorithm` into j and md.
-void run_regressions(const std::vector<RunRegression>& specs, const std::vector<RunData>& runs,
-                     const std::string& algorithm, nlohmann::ordered_json* j, std::string* md,
-                     std::vector<std::string>* warnings) {
+Named<OlsFitRecord> run_regressions(const std::vector<RunRegression>& specs,
+                                    const std::vector<RunData>& runs, const std::string& algorithm,
+                                    std::string* md, std::vector<std::string>* warnings) {
+  Named<OlsFitRecord> fits;
   for (const auto& spec : specs) {
     std::vector<double> y;
     std::vector<std::vector<double>> columns(spec.axes.size());
@@ -187,7 +177,7 @@ void run_regressions(const std::vector<RunRegression>& specs, const std::vector<
       y.push_back(v);
       for (std::size_t k = 0; k < x.size(); ++k) columns[k].push_back(x[k]);
     }
-    nlohmann::ordered_json jr;
+    OlsFitRecord fit;
     std::string subset;
     for (const auto& [axis, value] : spec.where)
       subset += (subset.empty() ? " with " : ", ") + axis + " = " + value;
@@ -197,15 +187,16 @@ void run_regressions(const std::vector<RunRegression>& specs, const std::vector<
       if (y.size() < spec.axes.size() + 2)
         throw UserError(fmt::format("got {} runs with a value, need at least {}", y.size(),
                                     spec.axes.size() + 2));
-      append_ols(eval::ols(y, columns, spec.axes), &jr, md);
+      fit = ols_record(eval::ols(y, columns, spec.axes), md);
     } catch (const UserError& e) {
-      jr["skipped"] = e.what();
+      fit.skipped = e.what();
       *md += std::string("Not fitted: ") + e.what() + "\n";
       warnings->push_back(
           fmt::format("{}: --regress {} not fitted: {}", algorithm, spec.text, e.what()));
     }
-    (*j)[spec.text] = jr;
+    fits[spec.text] = fit;
   }
+  return fits;
 }
 
 }  // namespace driftlab::study

@@ -11,6 +11,7 @@
 #include "eval/regression.hpp"
 #include "record/run_record.hpp"
 #include "study/sweep.hpp"
+#include "study/sweep_records.hpp"
 
 namespace driftlab::study {
 
@@ -34,15 +35,15 @@ struct RunRegression {
 std::vector<RunRegression> parse_run_regressions(const std::vector<std::string>& specs,
                                                  const SweepManifest& m);
 
-/// Fits each --regress over the runs of `algorithm` into j and md; a fit that cannot be made
-/// is recorded as skipped, with a warning.
-void run_regressions(const std::vector<RunRegression>& specs, const std::vector<RunData>& runs,
-                     const std::string& algorithm, nlohmann::ordered_json* j, std::string* md,
-                     std::vector<std::string>* warnings);
+/// Fits each --regress over the runs of `algorithm`, by its text, adding each to md; a fit
+/// that cannot be made is recorded as skipped, with a warning.
+Named<OlsFitRecord> run_regressions(const std::vector<RunRegression>& specs,
+                                    const std::vector<RunData>& runs, const std::string& algorithm,
+                                    std::string* md, std::vector<std::string>* warnings);
 
-/// An OLS fit into metrics.json (n, R^2, F, each coefficient) and summary.md (a table and
-/// the fit's paragraph).
-void append_ols(const eval::OlsResult& r, nlohmann::ordered_json* j, std::string* md);
+/// An OLS fit as metrics.json holds it (n, R^2, F, each coefficient), adding its part of
+/// summary.md (a table and the fit's paragraph) to md.
+OlsFitRecord ols_record(const eval::OlsResult& r, std::string* md);
 
 /// A number at a dotted key path of a JSON document, NaN when absent or not a number.
 double json_number(const nlohmann::json& j, const std::string& dotted);

@@ -24,22 +24,9 @@
 #include <vector>
 
 #include "core/hash.hpp"
+#include "study/sweep_records.hpp"
 
 namespace driftlab::study {
-
-enum class SweepDesign { kGrid, kZip, kRandom };
-constexpr auto enum_table(SweepDesign) {
-  return std::array{std::pair{SweepDesign::kGrid, "grid"}, std::pair{SweepDesign::kZip, "zip"},
-                    std::pair{SweepDesign::kRandom, "random"}};
-}
-
-/// How an axis lists its values in the sweep file.
-enum class AxisSpec { kValues, kRange, kLinspace, kLogspace };
-constexpr auto enum_table(AxisSpec) {
-  return std::array{std::pair{AxisSpec::kValues, "values"}, std::pair{AxisSpec::kRange, "range"},
-                    std::pair{AxisSpec::kLinspace, "linspace"},
-                    std::pair{AxisSpec::kLogspace, "logspace"}};
-}
 
 /// One swept scenario key.
 struct SweepAxis {
@@ -112,13 +99,6 @@ struct SweepJob {
   std::string hash;
 };
 
-/// Axis facts kept in sweep.json for the merge.
-struct AxisInfo {
-  std::string key, name;
-  std::string spec = "values";  // values, range, linspace or logspace
-  bool numeric = true;
-};
-
 struct SweepPlan {
   Sweep sweep;
   std::string scenario_yaml;  // the base scenario resolved, with `set` applied
@@ -127,7 +107,7 @@ struct SweepPlan {
   std::vector<SweepJob> jobs;
 
   /// sweep.json content.
-  nlohmann::json info() const;
+  SweepInfoRecord info() const;
   /// manifest.jsonl content.
   std::string manifest_jsonl() const;
 };
@@ -163,10 +143,10 @@ PlanWriteSummary write_plan(const SweepPlan& plan, const std::filesystem::path& 
 
 /// A sweep folder read back.
 struct SweepManifest {
-  std::filesystem::path dir;       // absolute
-  std::filesystem::path manifest;  // dir / manifest.jsonl
-  nlohmann::json info;             // sweep.json
-  std::vector<AxisInfo> axes;
+  std::filesystem::path dir;          // absolute
+  std::filesystem::path manifest;     // dir / manifest.jsonl
+  SweepInfoRecord info;               // sweep.json
+  std::vector<SweepAxisRecord> axes;  // info.axes, each with its column name
   std::vector<SweepJob> jobs;
 
   const SweepJob* find(const std::string& id) const;

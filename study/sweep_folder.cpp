@@ -3,6 +3,7 @@
 #include "study/sweep.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "core/process.hpp"
+#include "core/record_json.hpp"
 #include "core/yaml_io.hpp"
 
 namespace driftlab::study {
@@ -33,13 +35,48 @@ const SweepJob* SweepManifest::find(const std::string& id) const {
 }
 
 fs::path SweepManifest::base_dir() const {
-  if (info.contains("base_dir") && info["base_dir"].is_string()) {
-    const fs::path p = info["base_dir"].get<std::string>();
-    std::error_code ec;
-    if (fs::is_directory(p, ec)) return p;
-  }
+  std::error_code ec;
+  if (!info.base_dir.empty() && fs::is_directory(info.base_dir, ec)) return info.base_dir;
   return dir;
 }
+
+namespace {
+
+const char* kPlanned = "the sweep.json of `driftlab sweep plan`";
+
+SweepInfoRecord read_sweep_info(const fs::path& file) {
+  const auto j =
+      record_json::parse_json(read_text_file(file, "sweep.json"), file.string(), kPlanned);
+  if (!j.is_object() || !j.contains("axes"))
+    throw UserError(fmt::format("{}: no axes list, expected {}", file.string(), kPlanned));
+  return record_json::from_json<SweepInfoRecord>(j, file.string());
+}
+
+// One line of manifest.jsonl, its params rebuilt from the overrides (axis order).
+SweepJob read_manifest_job(const std::string& line, const std::string& where,
+                           const std::vector<SweepAxisRecord>& axes) {
+  const auto j = record_json::parse_json(line, where, "one job per line");
+  if (const auto missing = record_json::missing_keys<ManifestJobRecord>(j); !missing.empty())
+    throw UserError(fmt::format(
+        "{}: no {}, expected a job with id, index, point, replicate, seed, params, overrides "
+        "and hash",
+        where, fmt::join(missing, ", ")));
+  const auto rec = record_json::from_json<ManifestJobRecord>(j, where);
+  SweepJob job{rec.id, rec.index, rec.point, rec.replicate, rec.seed, {}, rec.overrides, rec.hash};
+  if (job.overrides.size() != axes.size() + 1)
+    throw UserError(
+        fmt::format("{}: job {}: got {} overrides, expected {} (one per axis of "
+                    "sweep.json, then the seed)",
+                    where, job.id, job.overrides.size(), axes.size() + 1));
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    const auto eq = job.overrides[i].find('=');
+    job.params.emplace_back(axes[i].name,
+                            eq == std::string::npos ? "" : job.overrides[i].substr(eq + 1));
+  }
+  return job;
+}
+
+}  // namespace
 
 SweepManifest read_manifest(const fs::path& manifest_or_dir) {
   SweepManifest m;
@@ -59,28 +96,10 @@ SweepManifest read_manifest(const fs::path& manifest_or_dir) {
   }
   const std::string text =
       read_text_file(m.manifest, "manifest (written by `driftlab sweep plan`)");
-  const fs::path info_file = m.dir / "sweep.json";
-  try {
-    m.info = nlohmann::json::parse(read_text_file(info_file, "sweep.json"));
-  } catch (const nlohmann::json::parse_error& e) {
-    throw UserError(
-        fmt::format("{}: not valid JSON ({}), expected the sweep.json of `driftlab "
-                    "sweep plan`",
-                    info_file.string(), e.what()));
-  }
-  if (!m.info.is_object() || !m.info.contains("axes") || !m.info["axes"].is_array())
-    throw UserError(
-        fmt::format("{}: no axes list, expected the sweep.json of `driftlab sweep "
-                    "plan`",
-                    info_file.string()));
-  for (const auto& a : m.info["axes"]) {
-    AxisInfo ai;
-    ai.key = a.value("key", "");
-    ai.name = a.value("name", ai.key);
-    ai.spec = a.value("spec", "values");
-    ai.numeric = a.value("numeric", false);
-    m.axes.push_back(ai);
-  }
+  m.info = read_sweep_info(m.dir / "sweep.json");
+  m.axes = m.info.axes;
+  for (auto& a : m.axes)
+    if (a.name.empty()) a.name = a.key;
   std::istringstream in(text);
   std::string line;
   std::size_t line_no = 0;
@@ -89,38 +108,7 @@ SweepManifest read_manifest(const fs::path& manifest_or_dir) {
     ++line_no;
     if (line.empty()) continue;
     const std::string where = fmt::format("{}:{}", m.manifest.string(), line_no);
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(line);
-    } catch (const nlohmann::json::parse_error& e) {
-      throw UserError(
-          fmt::format("{}: not valid JSON ({}), expected one job per line", where, e.what()));
-    }
-    SweepJob job;
-    try {
-      job.id = j.at("id").get<std::string>();
-      job.index = j.at("index").get<std::size_t>();
-      job.point = j.at("point").get<std::size_t>();
-      job.replicate = j.at("replicate").get<std::size_t>();
-      job.seed = j.at("seed").get<std::uint64_t>();
-      job.overrides = j.at("overrides").get<std::vector<std::string>>();
-      job.hash = j.at("hash").get<std::string>();
-    } catch (const nlohmann::json::exception& e) {
-      throw UserError(
-          fmt::format("{}: {}, expected a job with id, index, point, replicate, "
-                      "seed, overrides and hash",
-                      where, e.what()));
-    }
-    if (job.overrides.size() != m.axes.size() + 1)
-      throw UserError(
-          fmt::format("{}: job {}: got {} overrides, expected {} (one per axis of "
-                      "sweep.json, then the seed)",
-                      where, job.id, job.overrides.size(), m.axes.size() + 1));
-    for (std::size_t i = 0; i < m.axes.size(); ++i) {
-      const auto eq = job.overrides[i].find('=');
-      job.params.emplace_back(m.axes[i].name,
-                              eq == std::string::npos ? "" : job.overrides[i].substr(eq + 1));
-    }
+    SweepJob job = read_manifest_job(line, where, m.axes);
     if (job.index != m.jobs.size())
       throw UserError(fmt::format("{}: job {}: got index {}, expected {} (jobs in index order)",
                                   where, job.id, job.index, m.jobs.size()));
@@ -145,13 +133,14 @@ JobStatus job_status(const SweepManifest& m, const SweepJob& job) {
   const fs::path marker = m.marker(job.id);
   if (fs::exists(marker, ec)) {
     try {
-      const auto j = nlohmann::json::parse(read_text_file(marker, "completion marker"));
-      if (j.value("hash", "") == job.hash) {
+      const auto done = read_json_record<JobMarkerRecord>(marker, "completion marker",
+                                                          record_json::UnknownKeys::kIgnore);
+      if (done.hash == job.hash) {
         st.state = JobState::kDone;
       } else {
         st.state = JobState::kStale;
         st.detail = fmt::format("finished with parameter hash {}, the manifest now says {}",
-                                j.value("hash", "?"), job.hash);
+                                done.hash.empty() ? "?" : done.hash, job.hash);
       }
     } catch (const std::exception& e) {
       st.state = JobState::kStale;
@@ -163,10 +152,10 @@ JobStatus job_status(const SweepManifest& m, const SweepJob& job) {
   if (fs::exists(failed, ec)) {
     st.state = JobState::kFailed;
     try {
-      const auto j = nlohmann::json::parse(read_text_file(failed, "failure record"));
-      st.detail = j.value("status", "failed");
-      const std::string error = j.value("error", "");
-      if (!error.empty()) st.detail += ": " + first_line(error);
+      const auto f = read_json_record<FailureRecord>(failed, "failure record",
+                                                     record_json::UnknownKeys::kIgnore);
+      st.detail = f.status;
+      if (!f.error.empty()) st.detail += ": " + first_line(f.error);
     } catch (const std::exception&) {
       st.detail = "failed (unreadable record " + failed.string() + ")";
     }

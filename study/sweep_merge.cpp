@@ -79,19 +79,9 @@ const std::vector<RunMetric>& run_metrics() {
   return metrics;
 }
 
-nlohmann::ordered_json finite_or_null(double v) {
-  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
-}
-
 namespace {
 
-nlohmann::ordered_json stat_json(const Stat& s) {
-  return {{"n", s.n},
-          {"mean", finite_or_null(s.mean)},
-          {"sd", finite_or_null(s.sd)},
-          {"ci95_low", finite_or_null(s.lo)},
-          {"ci95_high", finite_or_null(s.hi)}};
-}
+RunStatRecord stat_record(const Stat& s) { return {s.n, s.mean, s.sd, s.lo, s.hi}; }
 
 }  // namespace
 
@@ -199,28 +189,22 @@ Covariates pooled_covariates(const SweepManifest& m, const MergeOptions& o, cons
 }
 
 // metrics.json's `sweep` block.
-nlohmann::ordered_json sweep_info_json(const SweepManifest& m, const Pool& pool) {
-  nlohmann::ordered_json j = {{"name", m.info.value("name", "")},
-                              {"design", m.info.value("design", "")},
-                              {"jobs", m.jobs.size()},
-                              {"merged_runs", pool.runs.size()},
-                              {"points", m.info.value("points", 0)},
-                              {"replicates", m.info.value("replicates", 1)},
-                              {"sections", pool.sections.size()}};
-  j["axes"] = nlohmann::ordered_json::array();
-  for (const auto& a : m.axes) j["axes"].push_back({{"key", a.key}, {"name", a.name}});
-  return j;
+SweepSummaryInfoRecord sweep_info_record(const SweepManifest& m, const Pool& pool) {
+  SweepSummaryInfoRecord r{m.info.name,   m.info.design,     m.jobs.size(),        pool.runs.size(),
+                           m.info.points, m.info.replicates, pool.sections.size(), {}};
+  for (const auto& a : m.axes) r.axes.push_back({a.key, a.name});
+  return r;
 }
 
 // summary.md's title, design and axes.
 std::string summary_head_md(const SweepManifest& m, const Pool& pool) {
-  std::string md = fmt::format("# Sweep {}\n\n", m.info.value("name", ""));
-  if (!m.info.value("description", "").empty()) md += m.info.value("description", "") + "\n\n";
+  std::string md = fmt::format("# Sweep {}\n\n", m.info.name);
+  if (!m.info.description.empty()) md += m.info.description + "\n\n";
   md += fmt::format(
       "Design {}, {} points x {} replicates = {} jobs; {} runs merged, {} sections "
       "pooled.\n\nAxes:\n\n",
-      m.info.value("design", ""), m.info.value("points", 0), m.info.value("replicates", 1),
-      m.jobs.size(), pool.runs.size(), pool.sections.size());
+      yaml::enum_name(m.info.design), m.info.points, m.info.replicates, m.jobs.size(),
+      pool.runs.size(), pool.sections.size());
   for (const auto& a : m.axes)
     md += a.name == a.key ? fmt::format("- `{}`\n", a.key)
                           : fmt::format("- `{}` (column `{}`)\n", a.key, a.name);
@@ -231,51 +215,68 @@ std::string summary_head_md(const SweepManifest& m, const Pool& pool) {
 }
 
 // A block of metrics.json with its part of summary.md.
+template <class Record>
 struct Part {
-  nlohmann::ordered_json json;
+  Record record;
   std::string md;
 };
 
-// River paper Table 1 over the pooled sections of one algorithm.
-Part pooled_section_errors(const Pool& pool, const std::vector<const PooledSection*>& rows) {
-  static const std::vector<std::pair<std::string, std::string>> section_errors = {
-      {"p_m_per_m", "ε'_p [m/m]"},           {"x_m_per_m", "ε'_x [m/m]"},
-      {"y_m_per_m", "ε'_y [m/m]"},           {"z_m_per_m", "ε'_z [m/m]"},
-      {"roll_deg_per_m", "ε'_roll [deg/m]"}, {"pitch_deg_per_m", "ε'_pitch [deg/m]"},
-      {"yaw_deg_per_m", "ε'_yaw [deg/m]"}};
-  Part p;
-  p.json["count"] = rows.size();
-  p.md = fmt::format("Pooled section errors, {} sections (river paper Table 1):\n\n", rows.size());
-  p.md += "| error | Min | Mean | Median | SD | Max | n |\n|---|---|---|---|---|---|---|\n";
-  for (const auto& [column, label] : section_errors) {
+// River paper Table 1 over the pooled sections of one algorithm: each error of the record,
+// from the sections.csv column of its key, labelled by its doc.
+class SectionErrorsFiller : public yaml::IgnoresRules {
+ public:
+  SectionErrorsFiller(const Pool& pool, const std::vector<const PooledSection*>& rows,
+                      std::string* md)
+      : pool_(pool), rows_(rows), md_(md) {}
+
+  void operator()(const char*, std::size_t&, const char*) {}  // the count
+  void operator()(const char* column, SectionErrorStatsRecord& r, const char* label) {
     std::vector<double> v;
-    for (const PooledSection* s : rows) {
-      const double x = cell_number(pool.value_of(*s, column));
+    for (const PooledSection* s : rows_) {
+      const double x = cell_number(pool_.value_of(*s, column));
       if (std::isfinite(x)) v.push_back(x);
     }
     const eval::Summary sum = eval::summarize(v);
-    p.json[column] = {{"n", sum.n},
-                      {"min", finite_or_null(v.empty() ? kNaN : sum.min)},
-                      {"mean", finite_or_null(v.empty() ? kNaN : sum.mean)},
-                      {"median", finite_or_null(v.empty() ? kNaN : sum.median)},
-                      {"sd", finite_or_null(v.size() < 2 ? kNaN : sum.sd_sample)},
-                      {"rmse", finite_or_null(v.empty() ? kNaN : sum.rmse)},
-                      {"max", finite_or_null(v.empty() ? kNaN : sum.max)}};
+    r = {sum.n,
+         v.empty() ? kNaN : sum.min,
+         v.empty() ? kNaN : sum.mean,
+         v.empty() ? kNaN : sum.median,
+         v.size() < 2 ? kNaN : sum.sd_sample,
+         v.empty() ? kNaN : sum.rmse,
+         v.empty() ? kNaN : sum.max};
     auto f = [&](double x, bool ok) { return ok ? fmt::format("{:.4g}", x) : std::string("—"); };
-    p.md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", label, f(sum.min, sum.n > 0),
+    *md_ += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", label, f(sum.min, sum.n > 0),
                         f(sum.mean, sum.n > 0), f(sum.median, sum.n > 0),
                         f(sum.sd_sample, sum.n > 1), f(sum.max, sum.n > 0), sum.n);
   }
+
+ private:
+  const Pool& pool_;
+  const std::vector<const PooledSection*>& rows_;
+  std::string* md_;
+};
+
+Part<PooledSectionsRecord> pooled_section_errors(const Pool& pool,
+                                                 const std::vector<const PooledSection*>& rows) {
+  Part<PooledSectionsRecord> p;
+  p.record.count = rows.size();
+  p.md = fmt::format("Pooled section errors, {} sections (river paper Table 1):\n\n", rows.size());
+  p.md += "| error | Min | Mean | Median | SD | Max | n |\n|---|---|---|---|---|---|---|\n";
+  SectionErrorsFiller fill(pool, rows, &p.md);
+  p.record.visit(fill);
   return p;
 }
 
 // OLS of the river paper's Eq. (13) on the pooled sections of one algorithm.
-Part pooled_regression(const Pool& pool, const std::vector<const PooledSection*>& rows,
-                       const std::string& response, const Covariates& covariates,
-                       const std::string& algorithm, std::vector<std::string>* warnings) {
-  Part p;
-  p.json["response"] = response;
-  p.json["covariates"] = covariates.names;
+Part<PooledRegressionRecord> pooled_regression(const Pool& pool,
+                                               const std::vector<const PooledSection*>& rows,
+                                               const std::string& response,
+                                               const Covariates& covariates,
+                                               const std::string& algorithm,
+                                               std::vector<std::string>* warnings) {
+  Part<PooledRegressionRecord> p;
+  p.record.response = response;
+  p.record.covariates = covariates.names;
   std::vector<std::string> names;
   for (const auto& c : covariates.names) {
     bool any = false;
@@ -300,7 +301,7 @@ Part pooled_regression(const Pool& pool, const std::vector<const PooledSection*>
     y.push_back(cell_number(pool.value_of(*s, response)));
     for (std::size_t k = 0; k < names.size(); ++k) columns[k].push_back(x[k]);
   }
-  p.json["dropped_sections"] = dropped;
+  p.record.dropped_sections = dropped;
   p.md = fmt::format(
       "\nRegression of `{}` on {} over the pool (river paper Eq. (13)):\n\n", response,
       names.empty() ? std::string("nothing") : fmt::format("`{}`", fmt::join(names, "`, `")));
@@ -314,13 +315,13 @@ Part pooled_regression(const Pool& pool, const std::vector<const PooledSection*>
         y.size(), names.size() + 2, names.size());
   } else {
     try {
-      append_ols(eval::ols(y, columns, names), &p.json, &p.md);
+      p.record.fit = ols_record(eval::ols(y, columns, names), &p.md);
     } catch (const UserError& e) {
       skipped = e.what();
     }
   }
   if (!skipped.empty()) {
-    p.json["skipped"] = skipped;
+    p.record.fit.skipped = skipped;
     p.md += "Not fitted: " + skipped + "\n";
     warnings->push_back(fmt::format("{}: regression not fitted: {}", algorithm, skipped));
   }
@@ -333,10 +334,10 @@ Part pooled_regression(const Pool& pool, const std::vector<const PooledSection*>
 // Every job's value of the gate's paired metrics (gate/gate.hpp), by job id, and every
 // section's position error by JOB/INDEX: what a baseline and a change are compared on pair by
 // pair. Non-finite values are left out.
-nlohmann::ordered_json per_pair_values(const Pool& pool, const std::string& algo,
-                                       const std::vector<const PooledSection*>& rows) {
-  nlohmann::ordered_json pairs;
-  auto& sections = pairs["p_m_per_m_sections"] = nlohmann::ordered_json::object();
+Named<Named<double>> per_pair_values(const Pool& pool, const std::string& algo,
+                                     const std::vector<const PooledSection*>& rows) {
+  Named<Named<double>> pairs;
+  auto& sections = pairs["p_m_per_m_sections"];
   for (const PooledSection* s : rows) {
     double v = 0;
     const auto it = s->cells.find("p_m_per_m");
@@ -346,7 +347,7 @@ nlohmann::ordered_json per_pair_values(const Pool& pool, const std::string& algo
       sections[pool.runs[s->run].job->id + "/" + index->second] = v;
   }
   for (const auto& rm : run_metrics()) {
-    nlohmann::ordered_json by_job = nlohmann::ordered_json::object();
+    Named<double> by_job;
     for (const auto& r : pool.runs)
       if (const double v = run_metric_value(r.metrics, algo, rm); std::isfinite(v))
         by_job[r.job->id] = v;
@@ -365,13 +366,9 @@ bool shown_paired(const std::string& metric) {
 
 // B against A over the pair names both have (`rename` maps a name to the one it pairs under),
 // as metrics.json holds it and as a summary row; nothing when no pair is common.
-struct PairedRow {
-  nlohmann::ordered_json json;
-  std::string md;
-};
-std::optional<PairedRow> paired_row(const std::string& label, const std::string& metric,
-                                    const std::map<std::string, double>& a_values,
-                                    const std::map<std::string, double>& b_values) {
+std::optional<Part<PairedRowRecord>> paired_row(const std::string& label, const std::string& metric,
+                                                const std::map<std::string, double>& a_values,
+                                                const std::map<std::string, double>& b_values) {
   std::vector<double> a, b;
   for (const auto& [id, v] : a_values)
     if (const auto it = b_values.find(id); it != b_values.end()) {
@@ -381,15 +378,9 @@ std::optional<PairedRow> paired_row(const std::string& label, const std::string&
   if (a.empty()) return std::nullopt;
   const gate::PairedChange c = gate::paired_change(a, b);
   const double p_two = std::min(1.0, 2 * std::min(c.test.p_greater, c.test.p_less));
-  PairedRow r;
-  r.json = {{"pairs", c.n},
-            {"mean_a", c.mean_a},
-            {"mean_b", c.mean_b},
-            {"diff", c.diff},
-            {"diff_ci95", {c.diff_lo, c.diff_hi}},
-            {"rel", c.rel},
-            {"rel_ci95", {c.rel_lo, c.rel_hi}},
-            {"p_signed_rank", p_two}};
+  Part<PairedRowRecord> r;
+  r.record = {c.n,  c.mean_a, c.mean_b, c.diff, {c.diff_lo, c.diff_hi}, c.rel, {c.rel_lo, c.rel_hi},
+              p_two};
   r.md = fmt::format("| {} | {} | {} | {:.4g} | {:.4g} | {:+.1f}% [{:+.1f}, {:+.1f}] | {:.2g} |\n",
                      label, metric, c.n, c.mean_a, c.mean_b, 100 * c.rel, 100 * c.rel_lo,
                      100 * c.rel_hi, p_two);
@@ -398,18 +389,18 @@ std::optional<PairedRow> paired_row(const std::string& label, const std::string&
 
 // The values of one paired metric by pair name; with `point`: only that point's jobs (job
 // names, not sections), named by their replicate ("-r01").
-std::map<std::string, double> pair_values(const nlohmann::ordered_json& values,
+std::map<std::string, double> pair_values(const Named<double>& values,
                                           std::optional<std::string> point = std::nullopt) {
   std::map<std::string, double> out;
-  for (const auto& [id, v] : values.items()) {
+  for (const auto& [id, v] : values) {
     if (!point) {
-      out[id] = v.get<double>();
+      out[id] = v;
       continue;
     }
     const auto dash = id.find('-');
     if (id.find('/') == std::string::npos && dash != std::string::npos &&
         id.substr(0, dash) == *point)
-      out[id.substr(dash)] = v.get<double>();
+      out[id.substr(dash)] = v;
   }
   return out;
 }
@@ -421,29 +412,28 @@ const char* kPairedHead =
 // each paired metric, the mean of B - A over the pairs both have (sections by JOB/INDEX, run
 // metrics by job) with its 95 % interval and the two-sided Wilcoxon signed-rank p-value
 // (gate/paired.hpp).
-Part paired_algorithms(const nlohmann::ordered_json& algorithms) {
-  Part p;
-  p.json = nlohmann::ordered_json::object();
-  std::vector<std::string> names;
-  for (const auto& [name, a] : algorithms.items())
-    if (a.contains("pairs")) names.push_back(name);
-  if (names.size() < 2) return p;
+Part<Named<Named<PairedRowRecord>>> paired_algorithms(
+    const Named<AlgorithmSummaryRecord>& algorithms) {
+  Part<Named<Named<PairedRowRecord>>> p;
+  std::vector<const std::pair<std::string, AlgorithmSummaryRecord>*> named;
+  for (const auto& entry : algorithms) named.push_back(&entry);
+  if (named.size() < 2) return p;
   p.md = std::string(
              "\n## Paired comparisons of the algorithms\n\nEach row compares B with A on the "
              "same jobs (and sections): the mean of B - A over the pairs both have, relative to "
              "A's mean, with its 95% interval, and the two-sided signed-rank p-value (every "
              "metric: metrics.json `paired`).\n\n") +
          kPairedHead;
-  for (std::size_t i = 0; i < names.size(); ++i)
-    for (std::size_t j = i + 1; j < names.size(); ++j) {
-      const std::string label = names[j] + " vs " + names[i];
-      const auto& b_all = algorithms[names[j]]["pairs"];
-      for (const auto& [metric, a_values] : algorithms[names[i]]["pairs"].items()) {
-        if (!b_all.contains(metric)) continue;
-        const auto row =
-            paired_row(label, metric, pair_values(a_values), pair_values(b_all[metric]));
+  for (std::size_t i = 0; i < named.size(); ++i)
+    for (std::size_t j = i + 1; j < named.size(); ++j) {
+      const std::string label = named[j]->first + " vs " + named[i]->first;
+      const auto& b_all = named[j]->second.pairs;
+      for (const auto& [metric, a_values] : named[i]->second.pairs) {
+        const Named<double>* b_values = b_all.find(metric);
+        if (!b_values) continue;
+        const auto row = paired_row(label, metric, pair_values(a_values), pair_values(*b_values));
         if (!row) continue;
-        p.json[label][metric] = row->json;
+        p.record[label][metric] = row->record;
         if (shown_paired(metric)) p.md += row->md;
       }
     }
@@ -454,9 +444,9 @@ Part paired_algorithms(const nlohmann::ordered_json& algorithms) {
 // every point share their seeds (common random numbers), so the runs pair by replicate. Run
 // metrics only: an axis that moves the vessel moves the sections too. The summary shows them
 // for sweeps of at most 8 points.
-Part paired_points(const nlohmann::ordered_json& algorithms, const Pool& pool) {
-  Part p;
-  p.json = nlohmann::ordered_json::object();
+Part<Named<Named<Named<PairedRowRecord>>>> paired_points(
+    const Named<AlgorithmSummaryRecord>& algorithms, const Pool& pool) {
+  Part<Named<Named<Named<PairedRowRecord>>>> p;
   std::vector<std::string> points;
   for (const auto& r : pool.runs) {
     const std::string pid = fmt::format("p{:04}", r.job->point);
@@ -470,15 +460,14 @@ Part paired_points(const nlohmann::ordered_json& algorithms, const Pool& pool) {
                "same replicates (their seeds are shared): as above, per algorithm (metrics.json "
                "`paired_points`; the points' parameters: `points`).\n\n") +
            kPairedHead;
-  for (const auto& [algo, a] : algorithms.items()) {
-    if (!a.contains("pairs")) continue;
+  for (const auto& [algo, a] : algorithms) {
     for (std::size_t k = 1; k < points.size(); ++k) {
       const std::string label = algo + ": " + points[k] + " vs " + points[0];
-      for (const auto& [metric, values] : a["pairs"].items()) {
+      for (const auto& [metric, values] : a.pairs) {
         const auto row = paired_row(label, metric, pair_values(values, points[0]),
                                     pair_values(values, points[k]));
         if (!row || metric == "p_m_per_m_sections") continue;
-        p.json[algo][points[k] + " vs " + points[0]][metric] = row->json;
+        p.record[algo][points[k] + " vs " + points[0]][metric] = row->record;
         if (show && shown_paired(metric)) p.md += row->md;
       }
     }
@@ -487,29 +476,27 @@ Part paired_points(const nlohmann::ordered_json& algorithms, const Pool& pool) {
 }
 
 // One algorithm: pooled Table 1, the pooled regression, run metrics and --regress fits.
-Part merge_algorithm(const Pool& pool, const std::string& algo, const MergeOptions& o,
-                     const Covariates& covariates, const std::vector<RunRegression>& regressions,
-                     std::vector<std::string>* warnings) {
+Part<AlgorithmSummaryRecord> merge_algorithm(const Pool& pool, const std::string& algo,
+                                             const MergeOptions& o, const Covariates& covariates,
+                                             const std::vector<RunRegression>& regressions,
+                                             std::vector<std::string>* warnings) {
   const std::vector<const PooledSection*> rows = pool.sections_of(algo);
-  Part p;
+  Part<AlgorithmSummaryRecord> p;
   p.md = fmt::format("\n## {}\n\n", algo);
-  Part errors = pooled_section_errors(pool, rows);
-  p.json["sections"] = errors.json;
+  auto errors = pooled_section_errors(pool, rows);
+  p.record.sections = errors.record;
   p.md += errors.md;
-  Part fit = pooled_regression(pool, rows, o.response, covariates, algo, warnings);
+  auto fit = pooled_regression(pool, rows, o.response, covariates, algo, warnings);
   p.md += fit.md;
-  p.json["regression"] = fit.json;
-  p.json["runs"] = nlohmann::ordered_json::object();
+  p.record.regression = fit.record;
   for (const auto& rm : run_metrics()) {
     std::vector<double> v;
     for (const auto& r : pool.runs) v.push_back(run_metric_value(r.metrics, algo, rm));
-    p.json["runs"][rm.name] = stat_json(stat_of(v));
+    p.record.runs[rm.name] = stat_record(stat_of(v));
   }
-  p.json["pairs"] = per_pair_values(pool, algo, rows);
-  if (!o.run_regressions.empty()) {
-    p.json["run_regressions"] = nlohmann::ordered_json::object();
-    run_regressions(regressions, pool.runs, algo, &p.json["run_regressions"], &p.md, warnings);
-  }
+  p.record.pairs = per_pair_values(pool, algo, rows);
+  if (!o.run_regressions.empty())
+    p.record.run_regressions = run_regressions(regressions, pool.runs, algo, &p.md, warnings);
   return p;
 }
 
@@ -548,7 +535,7 @@ std::string main_run_metric(const Pool& pool) {
 // mean over replicates with its 95 % interval.
 struct Points {
   std::string csv, md;
-  nlohmann::ordered_json json = nlohmann::ordered_json::object();
+  Named<PointRecord> record;
 };
 
 Points per_point(const SweepManifest& m, const Pool& pool) {
@@ -575,10 +562,9 @@ Points per_point(const SweepManifest& m, const Pool& pool) {
   for (const auto& [point, point_runs] : by_point) {
     const std::string pid = fmt::format("p{:04}", point);
     const auto& params = point_runs.front()->job->params;
-    nlohmann::ordered_json jp;
-    jp["params"] = nlohmann::ordered_json::object();
-    for (const auto& [name, value] : params) jp["params"][name] = yaml_text_to_json(value);
-    jp["runs"] = point_runs.size();
+    PointRecord jp;
+    for (const auto& [name, value] : params) jp.params[name] = yaml_text_to_json(value);
+    jp.runs = point_runs.size();
     out.md += "| " + pid + " |";
     for (const auto& [name, value] : params) out.md += " " + value + " |";
     for (const auto& algo : pool.algorithms) {
@@ -591,7 +577,7 @@ Points per_point(const SweepManifest& m, const Pool& pool) {
         for (const RunData* r : point_runs) v.push_back(run_metric_value(r->metrics, algo, rm));
         const Stat s = stat_of(v);
         for (double x : {s.mean, s.sd, s.lo, s.hi}) row.push_back(num(x));
-        jp["algorithms"][algo][rm.name] = stat_json(s);
+        jp.algorithms[algo][rm.name] = stat_record(s);
         if (rm.name == main_metric)
           out.md += s.n == 0   ? " — |"
                     : s.n == 1 ? fmt::format(" {:.4g} |", s.mean)
@@ -600,7 +586,7 @@ Points per_point(const SweepManifest& m, const Pool& pool) {
       out.csv += csv_row(row);
     }
     out.md += "\n";
-    out.json[pid] = jp;
+    out.record[pid] = jp;
   }
   return out;
 }
@@ -619,26 +605,25 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
   out.algorithms = pool.algorithms;
   const Covariates covariates = pooled_covariates(m, o, pool, &out.warnings);
 
-  nlohmann::ordered_json metrics;
-  metrics["sweep"] = sweep_info_json(m, pool);
-  metrics["algorithms"] = nlohmann::ordered_json::object();
+  SweepSummaryRecord metrics;
+  metrics.sweep = sweep_info_record(m, pool);
   std::string md = summary_head_md(m, pool);
   for (const auto& algo : pool.algorithms) {
-    Part p = merge_algorithm(pool, algo, o, covariates, regressions, &out.warnings);
+    auto p = merge_algorithm(pool, algo, o, covariates, regressions, &out.warnings);
     md += p.md;
-    metrics["algorithms"][algo] = std::move(p.json);
+    metrics.algorithms[algo] = std::move(p.record);
   }
-  Part paired = paired_algorithms(metrics["algorithms"]);
-  metrics["paired"] = std::move(paired.json);
+  auto paired = paired_algorithms(metrics.algorithms);
+  metrics.paired = std::move(paired.record);
   md += paired.md;
-  Part paired_pts = paired_points(metrics["algorithms"], pool);
-  metrics["paired_points"] = std::move(paired_pts.json);
+  auto paired_pts = paired_points(metrics.algorithms, pool);
+  metrics.paired_points = std::move(paired_pts.record);
   md += paired_pts.md;
-  const Points points = per_point(m, pool);
-  metrics["points"] = points.json;
+  Points points = per_point(m, pool);
+  metrics.points = std::move(points.record);
   md += points.md;
   // Plot warnings depend on the machine (is gnuplot installed?), not on the runs.
-  metrics["warnings"] = out.warnings;
+  metrics.warnings = out.warnings;
 
   // Write (aside, then rename into place), plots included.
   AtomicDirectory dir(out.dir, /*replace=*/true);
@@ -656,7 +641,7 @@ MergeSummary merge_sweep(const SweepManifest& m, const MergeOptions& o) {
     md += "\n## Warnings\n\n";
     for (const auto& w : out.warnings) md += "- " + w + "\n";
   }
-  write_file_atomic(dir.path() / "metrics.json", metrics.dump(2) + "\n");
+  write_file_atomic(dir.path() / "metrics.json", json_text(metrics));
   write_file_atomic(dir.path() / "summary.md", md);
   dir.commit();
   return out;

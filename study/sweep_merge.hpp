@@ -75,7 +75,4 @@ const std::vector<RunMetric>& run_metrics();
 double run_metric_value(const record::RunRecord& metrics, const std::string& algorithm,
                         const RunMetric& metric);
 
-/// `v` as JSON, or null where it is not finite (JSON has no NaN).
-nlohmann::ordered_json finite_or_null(double v);
-
 }  // namespace driftlab::study

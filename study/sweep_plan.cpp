@@ -303,55 +303,41 @@ nlohmann::json yaml_text_to_json(const std::string& text) {
   }
 }
 
-nlohmann::json SweepPlan::info() const {
-  nlohmann::json j;
-  j["format"] = 1;
-  j["name"] = sweep.name;
-  j["description"] = sweep.description;
-  j["sweep_file"] = sweep.file.string();
-  j["base"] = sweep.base.string();
-  j["base_dir"] = sweep.base.parent_path().string();
-  j["scenario"] = "scenario.yaml";
-  j["design"] = std::string(yaml::enum_name(sweep.design));
-  if (sweep.design == SweepDesign::kRandom) j["samples"] = sweep.samples;
-  j["replicates"] = sweep.replicates;
-  j["seed"] = seed;
-  j["points"] = points;
-  j["jobs"] = jobs.size();
-  j["set"] = nlohmann::json::object();
-  for (const auto& [k, v] : sweep.set) j["set"][k] = yaml_text_to_json(v);
-  j["axes"] = nlohmann::json::array();
+SweepInfoRecord SweepPlan::info() const {
+  SweepInfoRecord r;
+  r.name = sweep.name;
+  r.description = sweep.description;
+  r.sweep_file = sweep.file.string();
+  r.base = sweep.base.string();
+  r.base_dir = sweep.base.parent_path().string();
+  r.design = sweep.design;
+  if (sweep.design == SweepDesign::kRandom) r.samples = sweep.samples;
+  r.replicates = sweep.replicates;
+  r.seed = seed;
+  r.points = points;
+  r.jobs = jobs.size();
+  for (const auto& [k, v] : sweep.set) r.set[k] = yaml_text_to_json(v);
   for (const auto& a : sweep.axes) {
-    nlohmann::json ja{{"key", a.key},
-                      {"name", a.name},
-                      {"spec", std::string(yaml::enum_name(a.spec))},
-                      {"numeric", a.numeric}};
+    SweepAxisRecord ar{a.key, a.name, a.spec, a.numeric, std::nullopt, std::nullopt};
     if (a.continuous) {
-      ja["interval"] = {a.start, a.stop};
+      ar.interval = std::array{a.start, a.stop};
     } else {
-      ja["values"] = nlohmann::json::array();
-      for (const auto& l : a.levels) ja["values"].push_back(yaml_text_to_json(l));
+      ar.values.emplace();
+      for (const auto& l : a.levels) ar.values->push_back(yaml_text_to_json(l));
     }
-    j["axes"].push_back(ja);
+    r.axes.push_back(ar);
   }
-  j["driftlab_version"] = DRIFTLAB_VERSION;
-  return j;
+  r.driftlab_version = DRIFTLAB_VERSION;
+  return r;
 }
 
 std::string SweepPlan::manifest_jsonl() const {
   std::string out;
   for (const auto& job : jobs) {
-    nlohmann::ordered_json j;
-    j["id"] = job.id;
-    j["index"] = job.index;
-    j["point"] = job.point;
-    j["replicate"] = job.replicate;
-    j["seed"] = job.seed;
-    j["params"] = nlohmann::ordered_json::object();
-    for (const auto& [name, value] : job.params) j["params"][name] = yaml_text_to_json(value);
-    j["overrides"] = job.overrides;
-    j["hash"] = job.hash;
-    out += j.dump() + "\n";
+    ManifestJobRecord r{job.id,   job.index, job.point,     job.replicate,
+                        job.seed, {},        job.overrides, job.hash};
+    for (const auto& [name, value] : job.params) r.params[name] = yaml_text_to_json(value);
+    out += record_json::to_ordered_json(r).dump() + "\n";
   }
   return out;
 }
@@ -371,7 +357,7 @@ PlanWriteSummary write_plan(const SweepPlan& plan, const fs::path& dir_in, bool 
   summary.jobs = plan.jobs.size();
   summary.points = plan.points;
   const std::string manifest = plan.manifest_jsonl();
-  const std::string info = plan.info().dump(2) + "\n";
+  const std::string info = record_json::to_json(plan.info()).dump(2) + "\n";  // keys sorted
   std::error_code ec;
   if (fs::exists(dir / "manifest.jsonl", ec)) {
     std::string old_manifest, old_scenario;

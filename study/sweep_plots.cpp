@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // An axis's values in order: numeric ascending, else first appearance.
-std::vector<std::string> axis_values(const AxisInfo& a, const Pool& pool) {
+std::vector<std::string> axis_values(const SweepAxisRecord& a, const Pool& pool) {
   std::vector<std::string> values;
   for (const auto& r : pool.runs)
     for (const auto& [name, value] : r.job->params)
@@ -32,7 +32,7 @@ std::vector<std::string> axis_values(const AxisInfo& a, const Pool& pool) {
 // One plot's data: per algorithm a block of (x, mean, ci95 low, high, runs, label) over the
 // axis values (other axes and replicates pooled); the algorithms that have a block.
 std::pair<std::string, std::vector<std::pair<std::size_t, std::string>>> plot_data(
-    const AxisInfo& a, const std::vector<std::string>& values, const RunMetric& rm,
+    const SweepAxisRecord& a, const std::vector<std::string>& values, const RunMetric& rm,
     const Pool& pool) {
   std::string dat = fmt::format(
       "# {} vs {}: x, mean, ci95_low, ci95_high, runs, label; one "
@@ -65,10 +65,10 @@ std::pair<std::string, std::vector<std::pair<std::size_t, std::string>>> plot_da
 
 // The gnuplot script of one plot: series side by side (dodged by a little of the x range) so
 // that their bars do not hide one another.
-std::string plot_script(const AxisInfo& a, const std::vector<std::string>& values,
+std::string plot_script(const SweepAxisRecord& a, const std::vector<std::string>& values,
                         const RunMetric& rm, const std::string& stem, const std::string& terminal,
                         const std::vector<std::pair<std::size_t, std::string>>& series) {
-  bool log_x = a.spec == "logspace";
+  bool log_x = a.spec == AxisSpec::kLogspace;
   for (const auto& v : values) log_x = log_x && a.numeric && cell_number(v) > 0;
   std::string gp = fmt::format(
       "# Regenerate with: gnuplot {stem}.gp (in this folder)\n"

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <signal.h>
 #include <sys/file.h>
 #include <unistd.h>
@@ -66,16 +67,16 @@ std::string tail_of(const std::string& text, std::size_t max_lines = 20) {
 
 void write_failure(const SweepManifest& m, const SweepJob& job, const std::string& status,
                    const std::string& error, const std::string& log_tail = "") {
-  nlohmann::ordered_json j;
-  j["id"] = job.id;
-  j["status"] = status;
-  j["error"] = error;
-  if (!log_tail.empty()) j["log_tail"] = log_tail;
-  j["hash"] = job.hash;
-  j["host"] = host_name();
-  j["log"] = fs::relative(m.log_file(job.id), m.dir).string();
+  FailureRecord r;
+  r.id = job.id;
+  r.status = status;
+  r.error = error;
+  if (!log_tail.empty()) r.log_tail = log_tail;
+  r.hash = job.hash;
+  r.host = host_name();
+  r.log = fs::relative(m.log_file(job.id), m.dir).string();
   fs::create_directories(m.failed_record(job.id).parent_path());
-  write_file_atomic(m.failed_record(job.id), j.dump(2) + "\n");
+  write_file_atomic(m.failed_record(job.id), json_text(r));
 }
 
 void clear_failure(const SweepManifest& m, const SweepJob& job) {
@@ -89,8 +90,9 @@ std::string job_error(const SweepManifest& m, const SweepJob& job, const std::st
   std::error_code ec;
   if (fs::exists(m.failed_record(job.id), ec)) {
     try {
-      const auto j = nlohmann::json::parse(read_text_file(m.failed_record(job.id), "record"));
-      const std::string error = j.value("error", "");
+      const std::string error = read_json_record<FailureRecord>(m.failed_record(job.id), "record",
+                                                                record_json::UnknownKeys::kIgnore)
+                                    .error;
       if (!error.empty()) return error;
     } catch (const std::exception&) {
       // Cut short (the job was killed while writing it): fall back to the log.
@@ -226,17 +228,15 @@ JobRunResult run_manifest_job(const SweepManifest& m, const std::string& id,
     ro.progress = options.progress;
     ro.frame_cache = options.frame_cache;
     result.run = run_scenario(sc, out.path(), ro);
-    nlohmann::ordered_json marker;
-    marker["id"] = job.id;
-    marker["status"] = "done";
-    marker["hash"] = job.hash;
-    marker["seed"] = job.seed;
-    marker["params"] = nlohmann::ordered_json::object();
-    for (const auto& [name, value] : job.params) marker["params"][name] = yaml_text_to_json(value);
-    marker["host"] = host_name();
-    marker["wall_s"] = seconds_since(t0);
-    marker["driftlab_version"] = DRIFTLAB_VERSION;
-    write_file_atomic(out.path() / "job.json", marker.dump(2) + "\n");
+    JobMarkerRecord marker;
+    marker.id = job.id;
+    marker.hash = job.hash;
+    marker.seed = job.seed;
+    for (const auto& [name, value] : job.params) marker.params[name] = yaml_text_to_json(value);
+    marker.host = host_name();
+    marker.wall_s = seconds_since(t0);
+    marker.driftlab_version = DRIFTLAB_VERSION;
+    write_file_atomic(out.path() / "job.json", json_text(marker));
     out.commit();
     clear_failure(m, job);
   } catch (const std::exception& e) {
@@ -446,7 +446,7 @@ SlurmScript write_slurm_script(const SweepManifest& m, const SlurmOptions& o) {
   s.shards = shards;
   s.max_parallel = o.max_parallel;
   fs::create_directories(m.dir / "slurm" / "logs");
-  const std::string name = m.info.value("name", "sweep");
+  const std::string name = m.info.name.empty() ? "sweep" : m.info.name;
   std::string job_name;
   for (char c : name) job_name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
   std::string text = fmt::format(
@@ -485,10 +485,9 @@ SlurmScript write_slurm_script(const SweepManifest& m, const SlurmOptions& o) {
   fs::permissions(s.script, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
                   fs::perm_options::add);
   s.submit_command = "sbatch " + shell_quote(s.script.string());
-  nlohmann::ordered_json j{{"script", s.script.string()},    {"shards", shards},
-                           {"max_parallel", o.max_parallel}, {"cpus_per_task", o.cpus_per_task},
-                           {"partition", o.partition},       {"time", o.time}};
-  write_file_atomic(m.dir / "slurm" / "slurm.json", j.dump(2) + "\n");
+  const SlurmRecord r{s.script.string(), shards,      o.max_parallel,
+                      o.cpus_per_task,   o.partition, o.time};
+  write_file_atomic(m.dir / "slurm" / "slurm.json", json_text(r));
   return s;
 }
 
@@ -496,21 +495,15 @@ std::optional<SlurmScript> read_slurm_script(const SweepManifest& m) {
   const fs::path info = m.dir / "slurm" / "slurm.json";
   std::error_code ec;
   if (!fs::exists(info, ec)) return std::nullopt;
-  try {
-    const auto j = nlohmann::json::parse(read_text_file(info, "Slurm record"));
-    SlurmScript s;
-    s.script = j.at("script").get<std::string>();
-    s.shards = j.at("shards").get<std::size_t>();
-    s.max_parallel = j.value("max_parallel", std::size_t{0});
-    s.submit_command = "sbatch " + shell_quote(s.script.string());
-    if (s.shards < 1) return std::nullopt;
-    return s;
-  } catch (const std::exception& e) {
+  const char* expected = "the slurm.json of `driftlab sweep slurm-script`";
+  const auto j =
+      record_json::parse_json(read_text_file(info, "Slurm record"), info.string(), expected);
+  if (const auto missing = record_json::missing_keys<SlurmRecord>(j); !missing.empty())
     throw UserError(
-        fmt::format("{}: {}, expected the slurm.json of `driftlab sweep "
-                    "slurm-script`",
-                    info.string(), e.what()));
-  }
+        fmt::format("{}: no {}, expected {}", info.string(), fmt::join(missing, ", "), expected));
+  const auto r = record_json::from_json<SlurmRecord>(j, info.string());
+  if (r.shards < 1) return std::nullopt;
+  return SlurmScript{r.script, r.shards, r.max_parallel, "sbatch " + shell_quote(r.script)};
 }
 
 std::string resubmit_command(const SweepManifest& m, const SweepStatus& status,

@@ -185,5 +185,60 @@ TEST(RecordJson, DocumentsEveryKeyWithItsTypeAndMeaning) {
   EXPECT_NE(fields_markdown(rows).find("| `name` | string | a name |"), std::string::npos);
 }
 
+// Named<T>: an object whose keys keep the order they were added in.
+struct RjOrdered {
+  std::string zeta = "z";
+  Named<Named<int>> by_run;
+  double alpha = 1;
+  template <class A>
+  void visit(A& a) {
+    a("zeta", zeta, "first in the list");
+    a("by_run", by_run, "counts by run and name");
+    a("alpha", alpha, "last in the list");
+  }
+};
+
+TEST(RecordJson, TheOrderedWriterKeepsTheVisitOrderAndTheNamesOrder) {
+  RjOrdered r;
+  r.by_run["r2"]["b"] = 1;
+  r.by_run["r1"]["a"] = 2;
+  r.by_run["r2"]["a"] = 3;  // an existing name keeps its place
+  EXPECT_EQ(to_ordered_json(r).dump(),
+            R"({"zeta":"z","by_run":{"r2":{"b":1,"a":3},"r1":{"a":2}},"alpha":1.0})");
+  EXPECT_EQ(to_json(r).dump(),
+            R"({"alpha":1.0,"by_run":{"r1":{"a":2},"r2":{"a":3,"b":1}},"zeta":"z"})");
+  // Read from an ordered document, the names come back in the file's order.
+  const auto back = from_json<RjOrdered>(to_ordered_json(r), "o.json");
+  EXPECT_EQ(to_ordered_json(back).dump(), to_ordered_json(r).dump());
+  ASSERT_NE(back.by_run.find("r2"), nullptr);
+  EXPECT_EQ(back.by_run.find("r2")->items.front().first, "b");
+  EXPECT_EQ(back.by_run.find("r3"), nullptr);
+  const std::vector<FieldRow> rows = fields_of<RjOrdered>();
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[1].type, "object of names (in order) to object of names (in order) to integer");
+}
+
+TEST(RecordJson, ANewerWritersKeysCanBeLeftAsideAndRequiredKeysListed) {
+  const auto j = nlohmann::json::parse(R"({"name": "x", "inner": {"x": 1, "later": 2}, "new": 3})");
+  EXPECT_THROW(from_json<RjRecord>(j, "m.json"), UserError);
+  const auto r = from_json<RjRecord>(j, "m.json", UnknownKeys::kIgnore);
+  EXPECT_EQ(r.name, "x");
+  EXPECT_EQ(r.inner.x, 1);
+  EXPECT_EQ(missing_keys<RjOrdered>(nlohmann::json::parse(R"({"by_run": {}})")),
+            (std::vector<std::string>{"zeta", "alpha"}));
+  EXPECT_EQ(missing_keys<RjOrdered>(nlohmann::json::parse("[]")).size(), 3u);
+}
+
+TEST(RecordJson, ParseJsonNamesTheSourceAndWhatWasExpected) {
+  try {
+    parse_json("{\"a\": ", "sweep/sweep.json", "a sweep plan");
+    FAIL() << "no error";
+  } catch (const UserError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("sweep/sweep.json: not valid JSON (", 0), 0u) << what;
+    EXPECT_NE(what.find("), expected a sweep plan"), std::string::npos) << what;
+  }
+}
+
 }  // namespace
 }  // namespace driftlab::record_json

@@ -1,4 +1,5 @@
-// Cameras and scenes the renderer's tests share (render_test.cpp, cutout_test.cpp).
+// Cameras and scenes the renderer's tests share (render_test.cpp, render_backends_test.cpp,
+// cutout_test.cpp).
 #pragma once
 
 #include "core/rotation.hpp"
