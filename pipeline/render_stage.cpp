@@ -80,81 +80,114 @@ StereoRig rig_of(const sim::CameraOptions& c) {
   return rig;
 }
 
-RenderSequenceSummary render_sequence(const Scenario& sc_in, const std::filesystem::path& out_dir,
-                                      const RenderSequenceOptions& options) {
-  Scenario sc = sc_in;
-  if (options.max_frames > 0) sc.pipeline.max_frames = options.max_frames;
-  validate_scenario(sc, "scenario '" + sc.name + "'");
-  AtomicDirectory dir(out_dir, options.replace_existing);
-  std::filesystem::create_directories(dir.path() / "left");
-  std::filesystem::create_directories(dir.path() / "right");
-  if (options.depth) std::filesystem::create_directories(dir.path() / "depth");
-  if (options.masks) std::filesystem::create_directories(dir.path() / "mask");
-
-  // Ground-truth camera poses along the mission.
-  const SE3 T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
+struct RenderSequence::Impl {
+  Scenario sc;
+  bool depth, masks, profile;
   Trajectory poses;
   std::vector<FrameTruth> truth;
-  simulate_scenario_motion(sc, nullptr, [&](const sim::BodySample& b) {
-    poses.push_back({b.t_ns, b.state.T_W_B() * T_B_C});
-    Vec6 twist;
-    twist << b.state.v_B, b.state.w_B;
-    truth.push_back({ns_to_seconds(b.t_ns), b.state.T_W_B(), twist});
-  });
-  double north_min = 0, north_max = 0;
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    const double n = poses[i].T_W_C.translation().x();
-    north_min = i ? std::min(north_min, n) : n;
-    north_max = i ? std::max(north_max, n) : n;
+  RenderSequenceSummary summary;
+  std::unique_ptr<sim::StereoRenderer> renderer;
+  RngStreams rng;
+  std::unique_ptr<CameraStage> camera;
+  std::vector<sim::SampleTime> stamps;
+  std::size_t k = 0;
+
+  Impl(const Scenario& given, int max_frames, bool depth_, bool masks_, bool profile_)
+      : sc(given), depth(depth_), masks(masks_), profile(profile_), rng(given.seed) {
+    if (max_frames > 0) sc.pipeline.max_frames = max_frames;
+    validate_scenario(sc, "scenario '" + sc.name + "'");
+    depth = depth || sc.render.ground_truth_depth;
+    simulate_truth();
+    const auto t_scene = SteadyClock::now();
+    const auto [north_min, north_max] = north_extent();
+    const sim::SceneGeometry scene = scenes::build_scene(sc.scene, sc.seed, north_min, north_max);
+    summary.scene_build_s = seconds_since(t_scene);
+    renderer = std::make_unique<sim::StereoRenderer>(rig_of(sc.sensors.camera), sc.render);
+    renderer->upload(scene);
+    set_water_surface(renderer.get(), sc);
+    renderer->set_profiling(profile);
+    summary.triangles = renderer->triangles();
+    summary.context = renderer->context_description();
+    camera = std::make_unique<CameraStage>(sc, renderer.get(), rng);
+    stamps = sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
   }
 
-  RenderSequenceSummary summary;
-  const auto t_scene = SteadyClock::now();
-  const sim::SceneGeometry scene = scenes::build_scene(sc.scene, sc.seed, north_min, north_max);
-  summary.scene_build_s = seconds_since(t_scene);
-  sim::StereoRenderer renderer(rig_of(sc.sensors.camera), sc.render);
-  renderer.upload(scene);
-  set_water_surface(&renderer, sc);
-  renderer.set_profiling(options.profile);
-  summary.triangles = renderer.triangles();
-  summary.context = renderer.context_description();
+  // Ground-truth camera poses along the mission.
+  void simulate_truth() {
+    const SE3 T_B_C = camera_mount_T_B_C(sc.sensors.camera.mount);
+    simulate_scenario_motion(sc, nullptr, [&](const sim::BodySample& b) {
+      poses.push_back({b.t_ns, b.state.T_W_B() * T_B_C});
+      Vec6 twist;
+      twist << b.state.v_B, b.state.w_B;
+      truth.push_back({ns_to_seconds(b.t_ns), b.state.T_W_B(), twist});
+    });
+  }
 
+  std::pair<double, double> north_extent() const {
+    double north_min = 0, north_max = 0;
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      const double n = poses[i].T_W_C.translation().x();
+      north_min = i ? std::min(north_min, n) : n;
+      north_max = i ? std::max(north_max, n) : n;
+    }
+    return {north_min, north_max};
+  }
+};
+
+RenderSequence::RenderSequence(const Scenario& scenario, int max_frames, bool depth, bool masks,
+                               bool profile)
+    : impl_(std::make_unique<Impl>(scenario, max_frames, depth, masks, profile)) {}
+
+RenderSequence::~RenderSequence() = default;
+
+std::optional<RenderSequence::Frame> RenderSequence::next() {
+  Impl& m = *impl_;
+  while (m.k < m.poses.size() && m.k < m.stamps.size() && m.stamps[m.k].dropped) ++m.k;
+  if (m.k >= m.poses.size()) return std::nullopt;
+  const std::size_t k = m.k++;
+  const auto t0 = SteadyClock::now();
+  Frame f;
+  f.k = k;
+  f.t_ns = k < m.stamps.size() ? m.stamps[k].t_stamp_ns : m.poses[k].t_ns;
+  // Ground truth: the ideal pinhole camera at the centre of the exposure.
+  f.images = m.camera->capture_with_truth(m.truth[k], m.depth, m.masks, &f.moving_px);
+  m.summary.render_s += seconds_since(t0);
+  ++m.summary.frames;
+  return f;
+}
+
+const Trajectory& RenderSequence::poses() const { return impl_->poses; }
+
+RenderSequenceSummary RenderSequence::summary() const {
+  RenderSequenceSummary s = impl_->summary;
+  s.pairs_per_s = s.render_s > 0 ? static_cast<double>(s.frames) / s.render_s : 0;
+  if (impl_->profile) s.passes = impl_->renderer->pass_times();
+  return s;
+}
+
+RenderSequenceSummary render_sequence(const Scenario& sc, const std::filesystem::path& out_dir,
+                                      const RenderSequenceOptions& options) {
+  AtomicDirectory dir(out_dir, options.replace_existing);
+  RenderSequence frames(sc, options.max_frames, options.depth, options.masks, options.profile);
+  std::filesystem::create_directories(dir.path() / "left");
+  std::filesystem::create_directories(dir.path() / "right");
+  const bool depth = options.depth || sc.render.ground_truth_depth;
+  if (depth) std::filesystem::create_directories(dir.path() / "depth");
+  if (options.masks) std::filesystem::create_directories(dir.path() / "mask");
   AtomicFile times(dir.path() / "times.csv");
   times.write("frame,t_ns,moving_px\n");
-  const bool depth = options.depth || sc.render.ground_truth_depth;
-  double render_s = 0;
-  // The images as the camera delivers them (blur, rig error, lens, noise) at
-  // its clock's stamps; dropped frames are not written.
-  const RngStreams rng(sc.seed);
-  CameraStage camera(sc, &renderer, rng);
-  const std::vector<sim::SampleTime> stamps =
-      sim::camera_frame_times(sc.sensors.camera, rng, motion_end_s(sc));
-  std::size_t delivered = 0;
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    if (k < stamps.size() && stamps[k].dropped) continue;
-    const auto t0 = SteadyClock::now();
-    double moving_px = 0;
-    // Ground truth: the ideal pinhole camera at the centre of the exposure.
-    sim::StereoImages img = camera.capture_with_truth(truth[k], depth, options.masks, &moving_px);
-    render_s += seconds_since(t0);
-    ++delivered;
-    const std::string name = fmt::format("{:06d}", k);
-    write_png(dir.path() / "left" / (name + ".png"), img.left);
-    write_png(dir.path() / "right" / (name + ".png"), img.right);
-    if (depth) write_pfm(dir.path() / "depth" / (name + ".pfm"), img.depth_left);
-    if (options.masks) write_png(dir.path() / "mask" / (name + ".png"), img.moving_left);
-    times.write(fmt::format("{},{},{}\n", k,
-                            k < stamps.size() ? stamps[k].t_stamp_ns : poses[k].t_ns,
-                            yaml::format_double(moving_px)));
+  while (const auto f = frames.next()) {
+    const std::string name = fmt::format("{:06d}", f->k);
+    write_png(dir.path() / "left" / (name + ".png"), f->images.left);
+    write_png(dir.path() / "right" / (name + ".png"), f->images.right);
+    if (depth) write_pfm(dir.path() / "depth" / (name + ".pfm"), f->images.depth_left);
+    if (options.masks) write_png(dir.path() / "mask" / (name + ".png"), f->images.moving_left);
+    times.write(fmt::format("{},{},{}\n", f->k, f->t_ns, yaml::format_double(f->moving_px)));
   }
   times.commit();
-  write_tum(dir.path() / "groundtruth.tum", poses);
+  write_tum(dir.path() / "groundtruth.tum", frames.poses());
   dir.commit();
-  summary.frames = delivered;
-  summary.render_s = render_s;
-  summary.pairs_per_s = render_s > 0 ? static_cast<double>(delivered) / render_s : 0;
-  if (options.profile) summary.passes = renderer.pass_times();
-  return summary;
+  return frames.summary();
 }
 
 }  // namespace driftlab::pipeline
