@@ -221,8 +221,7 @@ int StudyCommands::run_local() {
 int StudyCommands::status() {
   const pl::SweepManifest m = pl::read_manifest(dir_);
   const pl::SweepStatus st = pl::sweep_status(m);
-  std::cout << fmt::format("sweep {} in {}\n{}\n", m.info.name, m.dir.string(),
-                           st.brief());
+  std::cout << fmt::format("sweep {} in {}\n{}\n", m.info.name, m.dir.string(), st.brief());
   constexpr std::size_t kShow = 20;
   for (const auto state : {pl::JobState::kFailed, pl::JobState::kStale, pl::JobState::kMissing}) {
     std::size_t n = 0;

@@ -319,7 +319,8 @@ class NedKalmanFilter : public NedFilterBase {
 /// Rng state and inputs give the same bytes. North and east are never measured, so resampling
 /// keeps thinning their spread (path degeneracy): with 1000 particles the particles' position
 /// covariance is a fraction of the true one and the position's Monte-Carlo error is tens of
-/// sqrt(P / N) (tests/fusion/ned_kalman_particle_test.cpp prints both); u, v and psi are unaffected.
+/// sqrt(P / N) (tests/fusion/ned_kalman_particle_test.cpp prints both); u, v and psi are
+/// unaffected.
 class NedParticleFilter : public NedFilterBase {
  public:
   using Options = NedParticleFilterOptions;
