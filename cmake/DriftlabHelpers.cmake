@@ -53,6 +53,8 @@ function(driftlab_module)
   set(target driftlab_${M_NAME})
   if(M_SOURCES)
     add_library(${target} STATIC ${M_SOURCES})
+    # Linked into the Python module too, a shared library.
+    set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ${DRIFTLAB_BUILD_PYTHON})
     # No fused multiply-add contraction: same bytes out on every x86-64 CPU.
     target_compile_options(${target} PRIVATE -ffp-contract=off)
     target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>

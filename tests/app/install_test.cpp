@@ -151,6 +151,24 @@ TEST(InstalledPackage, CustomVoProjectBuildsRegistersAndRuns) {
   EXPECT_NE(r.output.find("$DRIFTLAB_ASSET_DIR"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(root / "run3"));
 
+#ifdef DRIFTLAB_PYTHON_EXECUTABLE
+  // `import driftlab` from the prefix's dist-packages: its runs read the prefix's assets too.
+  fs::path site;
+  for (const auto& e : fs::directory_iterator(prefix / "lib"))
+    if (fs::exists(e.path() / "dist-packages/driftlab/__init__.py"))
+      site = e.path() / "dist-packages";
+  ASSERT_FALSE(site.empty()) << "no driftlab package under " << prefix / "lib";
+  r = run_shell("env -u DRIFTLAB_ASSET_DIR PYTHONPATH=" + shell_quote(site.string()) + " " +
+                shell_quote(DRIFTLAB_PYTHON_EXECUTABLE) + " -c " +
+                shell_quote("import driftlab, sys; s = driftlab.Scenario.load(sys.argv[1], "
+                            "set={'pipeline.max_frames': 2, 'pipeline.fusion': []}); "
+                            "print(driftlab.run(s, sys.argv[2]).render.assets)") +
+                " " + shell_quote(scenario) + " " + shell_quote((root / "run4").string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find((prefix / "share/driftlab/assets").string()), std::string::npos)
+      << r.output;
+#endif
+
   // driftlab itself has no lk_pnp: the reader names the choices.
   auto plain =
       test::run_cli({"scenario", "check", scenario, "-q", "--set", "pipeline.vo=[lk_pnp]"});
