@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -25,6 +26,7 @@
 #include "app/study_commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/record_json.hpp"
 #include "core/trajectory_io.hpp"
 #include "eval/evaluate.hpp"
 #include "gate/gate.hpp"
@@ -117,6 +119,33 @@ driftlab::eval::FrameTable read_covariates(const EvalArgs& a, const std::string&
   return eval::run_vo_covariates(table, vo, a.covariates);
 }
 
+// metrics.json of `driftlab eval`: the inputs, the evaluation under algorithms.NAME, and the
+// same evaluation at the top level, for quick access.
+struct EvalCommandRecord {
+  struct Inputs {
+    std::string gt, est, format, covariates, attitude_reference;
+    template <class A>
+    void visit(A& a) {
+      a("gt", gt, "--gt");
+      a("est", est, "--est");
+      a("format", format, "--format");
+      a("covariates", covariates, "--covariates");
+      a("attitude_reference", attitude_reference, "--attitude-reference");
+    }
+  };
+  std::string version;
+  Inputs inputs;
+  std::map<std::string, driftlab::eval::EvaluationRecord> algorithms;
+  driftlab::eval::EvaluationRecord evaluation;
+  template <class A>
+  void visit(A& a) {
+    a("version", version, "the driftlab that wrote it");
+    a("inputs", inputs, "the files evaluated");
+    a("algorithms", algorithms, "the evaluation, under the algorithm's name");
+    evaluation.visit(a);
+  }
+};
+
 int eval_command(const EvalArgs& a) {
   namespace eval = driftlab::eval;
   eval::EvaluationInput in;
@@ -153,17 +182,13 @@ int eval_command(const EvalArgs& a) {
   const eval::Evaluation e = eval::evaluate(in);
 
   driftlab::AtomicDirectory dir(a.out, a.force);
-  nlohmann::json metrics;
-  metrics["version"] = DRIFTLAB_VERSION;
-  metrics["inputs"] = {{"gt", a.gt},
-                       {"est", a.est},
-                       {"format", a.format},
-                       {"covariates", a.covariates},
-                       {"attitude_reference", a.attitude_reference}};
-  metrics["algorithms"][e.algorithm] = eval::to_json(e, in.options);
-  // The single algorithm's metrics also at the top level, for quick access.
-  for (auto& [key, value] : metrics["algorithms"][e.algorithm].items()) metrics[key] = value;
-  driftlab::write_file_atomic(dir.path() / "metrics.json", metrics.dump(2) + "\n");
+  EvalCommandRecord metrics;
+  metrics.version = DRIFTLAB_VERSION;
+  metrics.inputs = {a.gt, a.est, a.format, a.covariates, a.attitude_reference};
+  metrics.evaluation = eval::evaluation_record(e, in.options);
+  metrics.algorithms[e.algorithm] = metrics.evaluation;
+  driftlab::write_file_atomic(dir.path() / "metrics.json",
+                              driftlab::record_json::to_json(metrics).dump(2) + "\n");
   driftlab::write_file_atomic(dir.path() / "sections.csv", eval::sections_csv(e));
   driftlab::write_file_atomic(dir.path() / "tables.md", eval::tables_markdown(e, in.options));
   dir.commit();
