@@ -43,7 +43,7 @@ std::string bag_info_yaml(const ExportCalibration& cal, std::size_t frames,
       "  {}: /cam0/image_raw, /cam1/image_raw (mono8, rectified, baseline {} m), "
       "/camN/camera_info, /imu0, /gps/fix, /mag, /compass/heading, /groundtruth/pose (imu in "
       "world_ned), /tf_static\n"
-      "  {}: Kalibr's camera chain (OpenVINS, Basalt, Kimera; driftlab vo reads it)\n"
+      "  {}: Kalibr's camera chain (OpenVINS, Kimera; driftlab vo reads it)\n"
       "  {}: Kalibr's IMU noise model\n"
       "  vins_fusion/: VINS-Fusion's stereo + IMU configuration and camera files\n"
       "  scenario.resolved.yaml: the scenario that made this dataset\n",

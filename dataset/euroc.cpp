@@ -82,6 +82,10 @@ std::string euroc_info_yaml(const ExportCalibration& cal, std::size_t frames) {
       "q_RS), velocity v_RS_R and the simulated IMU's biases b_w_RS_S, b_a_RS_S, at most "
       "200 Hz\n"
       "  mav0/gps0/data.csv, mav0/compass0/data.csv: driftlab's own GPS and compass CSVs\n"
+      "  basalt_calib.json: Basalt's camera calibration (basalt_vio --cam-calib)\n"
+      "  orbslam3_stereo.yaml, orbslam3_stereo_inertial.yaml: ORB-SLAM3's settings (the second "
+      "with an IMU)\n"
+      "  orbslam3_times.txt: ORB-SLAM3's times file, one image stamp [ns] a line\n"
       "  scenario.resolved.yaml: the scenario that made this dataset\n",
       cal.source, frames, yaml::format_double(cal.camera_rate_hz), cal.rig.baseline_m);
 }
@@ -99,6 +103,7 @@ class EurocWriter final : public DatasetWriter {
     write_png(mav_ / "cam0" / "data" / name, left);
     write_png(mav_ / "cam1" / "data" / name, right);
     index_ += fmt::format("{},{}\n", t, name);
+    stamps_.push_back(t);
     ++frames_;
   }
   bool wants_depth() const override { return false; }
@@ -125,15 +130,28 @@ class EurocWriter final : public DatasetWriter {
                             biases);
     for (const auto& csv : truth.sensor_csvs)
       move_file(csv, mav_ / (csv.stem().string() + "0") / "data.csv");
-    if (fs::exists(mav_ / "imu0" / "data.csv"))
-      write_file_atomic(mav_ / "imu0" / "sensor.yaml", imu_yaml(cal_.imu));
+    const bool imu = fs::exists(mav_ / "imu0" / "data.csv");
+    if (imu) write_file_atomic(mav_ / "imu0" / "sensor.yaml", imu_yaml(cal_.imu));
+    write_peer_settings(imu);
     write_file_atomic(root_ / "info.yaml", euroc_info_yaml(cal_, frames_));
   }
 
  private:
+  // What Basalt and ORB-SLAM3 read beside the folder (docs/datasets.md, "Peers on the twin").
+  void write_peer_settings(bool imu) const {
+    ExportCalibration cal = cal_;
+    if (!imu) cal.imu = {};
+    write_file_atomic(root_ / "basalt_calib.json", basalt_calibration_json(cal));
+    write_file_atomic(root_ / "orbslam3_stereo.yaml", orbslam3_settings_yaml(cal, false));
+    if (imu)
+      write_file_atomic(root_ / "orbslam3_stereo_inertial.yaml", orbslam3_settings_yaml(cal, true));
+    write_file_atomic(root_ / "orbslam3_times.txt", orbslam3_times(stamps_));
+  }
+
   fs::path root_, mav_;
   ExportCalibration cal_;
   std::string index_;
+  std::vector<TimeNs> stamps_;
   std::size_t frames_ = 0;
 };
 

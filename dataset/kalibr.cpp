@@ -1,5 +1,5 @@
-// Calibration files of the tools that read bags: Kalibr's camera and IMU chains (as OpenVINS,
-// Basalt's converters and Kimera read them; github.com/ethz-asl/kalibr/wiki/yaml-formats) and
+// Calibration files of the tools that read bags: Kalibr's camera and IMU chains (as OpenVINS
+// and Kimera read them; github.com/ethz-asl/kalibr/wiki/yaml-formats) and
 // VINS-Fusion's EuRoC-style configuration (OpenCV FileStorage YAML). Writers and the camera
 // chain's reader.
 #include <fmt/format.h>

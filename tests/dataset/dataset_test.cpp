@@ -9,10 +9,13 @@
 
 #include <fstream>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <set>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -185,6 +188,134 @@ TEST(EurocExport, FollowsTheAslLayoutAndReadsBack) {
   EXPECT_TRUE(d.has_extrinsics);
   EXPECT_TRUE(d.compass.empty());  // no compass0
   fs::remove_all(root);
+}
+
+// Stand-ins for Basalt and ORB-SLAM3: each reads its settings beside the EuRoC folder as that
+// system does (Basalt: cereal's names and JSON types; ORB-SLAM3 v1.0: OpenCV's FileStorage,
+// reals where Settings.cc reads floats, ints where it reads ints, matrices of floats), and the
+// values must be the ones the folder's own sensor.yaml files hold.
+SE3 basalt_pose(const nlohmann::json& p) {
+  for (const char* k : {"px", "py", "pz", "qx", "qy", "qz", "qw"})
+    EXPECT_TRUE(p.at(k).is_number_float()) << k;
+  return SE3(Quat(p["qw"].get<double>(), p["qx"].get<double>(), p["qy"].get<double>(),
+                  p["qz"].get<double>()),
+             Vec3(p["px"].get<double>(), p["py"].get<double>(), p["pz"].get<double>()));
+}
+
+SE3 t_bs_of(const fs::path& sensor_yaml) {
+  const auto d = YAML::LoadFile(sensor_yaml.string())["T_BS"]["data"].as<std::vector<double>>();
+  Mat4 m;
+  for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = d[static_cast<std::size_t>(i)];
+  return SE3(m);
+}
+
+void expect_basalt_reads(const fs::path& root, const ExportCalibration& cal, bool imu) {
+  const auto j = nlohmann::json::parse(slurp(root / "basalt_calib.json")).at("value0");
+  std::set<std::string> keys;
+  for (const auto& [k, _] : j.items()) keys.insert(k);
+  EXPECT_EQ(keys, (std::set<std::string>{"T_imu_cam", "intrinsics", "resolution", "vignette",
+                                         "calib_accel_bias", "calib_gyro_bias", "imu_update_rate",
+                                         "accel_noise_std", "gyro_noise_std", "accel_bias_std",
+                                         "gyro_bias_std", "cam_time_offset_ns"}));
+  for (int i = 0; i < 2; ++i) {
+    const fs::path cam = root / "mav0" / fmt::format("cam{}", i) / "sensor.yaml";
+    EXPECT_LT(pose_difference(basalt_pose(j["T_imu_cam"][i]), t_bs_of(cam)), 1e-9) << i;
+    EXPECT_EQ(j["intrinsics"][i]["camera_type"], "pinhole");
+    EXPECT_EQ(j["intrinsics"][i]["intrinsics"]["fx"].get<double>(), cal.rig.camera.fx);
+    EXPECT_EQ(j["intrinsics"][i]["intrinsics"]["cy"].get<double>(), cal.rig.camera.cy);
+    EXPECT_TRUE(j["resolution"][i][0].is_number_integer());
+    EXPECT_EQ(j["resolution"][i],
+              nlohmann::json::array({cal.rig.camera.width, cal.rig.camera.height}));
+  }
+  EXPECT_EQ(j["calib_accel_bias"].size(), 9u);
+  EXPECT_EQ(j["calib_gyro_bias"].size(), 12u);
+  EXPECT_TRUE(j["cam_time_offset_ns"].is_number_integer());
+  if (!imu) {
+    EXPECT_EQ(j["imu_update_rate"].get<double>(), 200);  // Basalt's default: a VO run
+    return;
+  }
+  const YAML::Node m = YAML::LoadFile((root / "mav0" / "imu0" / "sensor.yaml").string());
+  EXPECT_EQ(j["imu_update_rate"].get<double>(), m["rate_hz"].as<double>());
+  EXPECT_EQ(j["gyro_noise_std"][2].get<double>(), m["gyroscope_noise_density"].as<double>());
+  EXPECT_EQ(j["accel_noise_std"][0].get<double>(), m["accelerometer_noise_density"].as<double>());
+  EXPECT_EQ(j["gyro_bias_std"][1].get<double>(), m["gyroscope_random_walk"].as<double>());
+  EXPECT_EQ(j["accel_bias_std"][0].get<double>(), m["accelerometer_random_walk"].as<double>());
+}
+
+void expect_orbslam3_reads(const fs::path& file, const ExportCalibration& cal, bool inertial) {
+  const cv::FileStorage fs(file.string(), cv::FileStorage::READ);
+  ASSERT_TRUE(fs.isOpened()) << file;
+  EXPECT_TRUE(fs["File.version"].isString());
+  EXPECT_EQ(static_cast<std::string>(fs["File.version"]), "1.0");
+  EXPECT_EQ(static_cast<std::string>(fs["Camera.type"]), "Rectified");
+  std::vector<std::string> reals = {"Camera1.fx",
+                                    "Camera1.fy",
+                                    "Camera1.cx",
+                                    "Camera1.cy",
+                                    "Stereo.b",
+                                    "Stereo.ThDepth",
+                                    "ORBextractor.scaleFactor"};
+  for (const char* v :
+       {"KeyFrameSize", "KeyFrameLineWidth", "GraphLineWidth", "PointSize", "CameraSize",
+        "CameraLineWidth", "ViewpointX", "ViewpointY", "ViewpointZ", "ViewpointF"})
+    reals.push_back(std::string("Viewer.") + v);
+  std::vector<std::string> ints = {"Camera.width",
+                                   "Camera.height",
+                                   "Camera.fps",
+                                   "Camera.RGB",
+                                   "ORBextractor.nFeatures",
+                                   "ORBextractor.nLevels",
+                                   "ORBextractor.iniThFAST",
+                                   "ORBextractor.minThFAST"};
+  if (inertial)
+    for (const char* k :
+         {"IMU.NoiseGyro", "IMU.NoiseAcc", "IMU.GyroWalk", "IMU.AccWalk", "IMU.Frequency"})
+      reals.push_back(k);
+  for (const auto& k : reals) EXPECT_TRUE(fs[k].isReal()) << file << ": " << k;
+  for (const auto& k : ints) EXPECT_TRUE(fs[k].isInt()) << file << ": " << k;
+  EXPECT_EQ(static_cast<double>(fs["Camera1.fx"]), cal.rig.camera.fx);
+  EXPECT_EQ(static_cast<double>(fs["Stereo.b"]), cal.rig.baseline_m);
+  EXPECT_EQ(static_cast<int>(fs["Camera.fps"]), 10);
+  EXPECT_EQ(fs["IMU.T_b_c1"].empty(), !inertial);
+  if (!inertial) return;
+  EXPECT_EQ(static_cast<double>(fs["IMU.NoiseAcc"]), cal.imu.accelerometer_noise_density);
+  cv::Mat T;
+  fs["IMU.T_b_c1"] >> T;
+  ASSERT_EQ(T.type(), CV_32F);  // Converter::toSophus reads floats
+  ASSERT_EQ(T.rows * T.cols, 16);
+  const Mat4 expected = cal.T_S_C.matrix();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(T.at<float>(r, c), expected(r, c), 1e-6);
+}
+
+TEST(EurocExport, BasaltAndOrbSlam3FindTheirSettingsAndTimesBesideTheFolder) {
+  for (const bool imu : {true, false}) {
+    const fs::path root = test::fresh_temp_dir(imu ? "euroc_peers_imu" : "euroc_peers_vo");
+    const fs::path staging = root / "staging";
+    fs::create_directories(staging);
+    Sequence seq;
+    if (imu) {
+      write_euroc_imu(staging / "imu.csv", {{900'000'000, Vec3(0, 0, 0), Vec3(0, 0, -9.8)},
+                                            {1'300'000'000, Vec3(0, 0, 0), Vec3(0, 0, -9.8)}});
+      seq.truth.sensor_csvs = {staging / "imu.csv"};
+    }
+    const auto writer = make_writer(DatasetFormat::kEuroc, root, calibration());
+    seq.write(*writer);
+    expect_basalt_reads(root, calibration(), imu);
+    expect_orbslam3_reads(root / "orbslam3_stereo.yaml", calibration(), false);
+    EXPECT_EQ(fs::exists(root / "orbslam3_stereo_inertial.yaml"), imu);
+    if (imu) expect_orbslam3_reads(root / "orbslam3_stereo_inertial.yaml", calibration(), true);
+    // The times file: each line a PNG's name in cam0 and cam1 (the examples read no data.csv).
+    std::istringstream times(slurp(root / "orbslam3_times.txt"));
+    std::vector<TimeNs> stamps;
+    for (std::string line; std::getline(times, line);) {
+      stamps.push_back(std::stoll(line));
+      EXPECT_TRUE(fs::exists(root / "mav0/cam0/data" / (line + ".png"))) << line;
+      EXPECT_TRUE(fs::exists(root / "mav0/cam1/data" / (line + ".png"))) << line;
+    }
+    EXPECT_EQ(stamps, seq.stamps);
+    fs::remove_all(root);
+  }
 }
 
 TEST(TumRgbdExport, DepthIsSixteenBitAtFiveThousandPerMetre) {
