@@ -404,10 +404,11 @@ struct PaperVerb : Pinned {
                     "Row of the paper's Table 2: discharge (four crossings) or total (the "
                     "survey); default: from the run's scenario name");
     cmd->add_option("--prism", prism,
-                    "Where the river paper's truth was measured, from the camera in its optical "
-                    "frame (x right, y down, z forward) [m], for the twin's columns at the "
-                    "prism beside those at the camera; none: the camera's only")
-        ->default_val(driftlab::app::kRiverPrism);
+                    "Where the river paper's truth was measured, X,Y,Z from the camera in its "
+                    "optical frame (x right, y down, z forward) [m], for the twin's columns at "
+                    "the prism beside those at the camera; default: 1 m above the centre of "
+                    "gravity on the centre line, placed by the run's camera mount; none: the "
+                    "camera's only");
     cmd->add_option("--out", out, "Write the Markdown to this file (default: stdout)");
   }
 
@@ -418,7 +419,7 @@ struct PaperVerb : Pinned {
 
   CLI::App* cmd = nullptr;
   std::vector<std::string> runs;
-  std::string track, prism = driftlab::app::kRiverPrism, out;
+  std::string track, prism, out;
 };
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "core/yaml_io.hpp"
 #include "eval/evaluate.hpp"
 #include "gate/gate.hpp"
+#include "pipeline/run.hpp"
 #include "pipeline/scenario.hpp"
 #include "record/run_record.hpp"
 #include "report/basin_paper_compare.hpp"
@@ -57,6 +58,14 @@ void add_prism_columns(const fs::path& run_dir, const std::array<double, 3>& pri
   }
 }
 
+// kRiverPrismFrd in the optical frame of the run's left camera, through its mount.
+std::array<double, 3> river_prism_from_camera(const fs::path& run_dir) {
+  const pipeline::Scenario sc = pipeline::load_scenario(run_dir / "scenario.resolved.yaml");
+  const Vec3 p_B(kRiverPrismFrd[0], kRiverPrismFrd[1], kRiverPrismFrd[2]);
+  const Vec3 p_C = pipeline::camera_mount_T_B_C(sc.sensors.camera.mount).inverse() * p_B;
+  return {p_C.x(), p_C.y(), p_C.z()};
+}
+
 }  // namespace
 
 int paper_command(const std::vector<std::string>& runs, const std::string& track_name,
@@ -96,12 +105,13 @@ int paper_command(const std::vector<std::string>& runs, const std::string& track
       sparse->second.evaluation.association.reference_point_m == std::array<double, 3>{0, 0, 0};
   const fs::path dir = files.front().parent_path();
   if (prism != "none" && at_camera) {
-    const std::array<double, 3> point = prism_point(prism);
+    const std::optional<std::array<double, 3>> given =
+        prism.empty() ? std::nullopt : std::optional(prism_point(prism));
     std::string missing;
     for (const char* f : {"scenario.resolved.yaml", "groundtruth.tum", "frames.csv"})
       if (!fs::exists(dir / f)) missing += (missing.empty() ? "" : ", ") + std::string(f);
     if (missing.empty())
-      add_prism_columns(dir, point, &metrics);
+      add_prism_columns(dir, given ? *given : river_prism_from_camera(dir), &metrics);
     else
       std::cerr << fmt::format(
           "warning: no columns at the prism: {} lacks {} (the run's files that the twin is "

@@ -432,7 +432,8 @@ std::string reference_point_note(const AlgorithmRecord& algorithm, std::string_v
   const std::array<double, 3>& l = algorithm.evaluation.association.reference_point_m;
   if (l == std::array<double, 3>{0.0, 0.0, 0.0}) return "";
   return fmt::format(
-      "{} truth is measured {:.2f} m from its camera, at [{}, {}, {}] m in the camera's "
+      "{} truth is measured {:.2f} m from its camera, at [{:.3g}, {:.3g}, {:.3g}] m in the "
+      "camera's "
       "frame (x right, y down, z forward; `eval.reference_point_m`, `driftlab paper --prism`), "
       "as the paper's total station tracked a prism on the vessel; the estimates are the "
       "camera's, with no lever-arm correction.\n\n",

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -523,6 +524,35 @@ TEST(Cli, PaperPutsTheRiverPaperBesideARunAndAsksForTheTrackOfOtherScenarios) {
   EXPECT_NE(r.err.find("--prism 0,0"), std::string::npos) << r.err;
   r = run_cli({"paper", (dir / "missing").string()});
   EXPECT_EQ(r.exit_code, 1) << r.output;
+  fs::remove_all(dir);
+}
+
+// The prism's default: 1 m above the centre of gravity on the centre line, seen from the run's
+// camera through its mount (lever arm, pitch and yaw), here a mount other than the shipped one.
+TEST(Cli, PaperPlacesTheDefaultPrismThroughTheRunsCameraMount) {
+  const fs::path dir = fresh_temp_dir("paper_prism");
+  const double pitch = -20 * M_PI / 180, yaw = 45 * M_PI / 180;
+  Result r = run_cli({"run", (kSource / "scenarios/river_crossing.yaml").string(), "--out",
+                      (dir / "run").string(), "--set", "pipeline.max_frames=12", "--set",
+                      "pipeline.vo=[sparse]", "--set", "pipeline.fusion=[]", "--set",
+                      "sensors.camera.mount.rpy_deg=[0,-20,45]", "--set",
+                      "sensors.camera.mount.position_frd_m=[-0.5,0.2,-0.4]"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_cli({"paper", (dir / "run").string(), "--out", (dir / "paper.md").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // The prism from the camera, body FRD: (0, 0, -1) - (-0.5, 0.2, -0.4). The optical axes in
+  // the body: z forward along the mount's yaw and pitch (negative: down), x to its right, level
+  // (no roll), y = z x x down.
+  const double d[3] = {0.5, -0.2, -0.6};
+  const double z[3] = {std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw),
+                       -std::sin(pitch)};
+  const double x[3] = {-std::sin(yaw), std::cos(yaw), 0};
+  const double y[3] = {z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2],
+                       z[0] * x[1] - z[1] * x[0]};
+  auto dot = [&](const double* a) { return a[0] * d[0] + a[1] * d[1] + a[2] * d[2]; };
+  const std::string expected =
+      fmt::format("at [{:.3g}, {:.3g}, {:.3g}] m in the camera's frame", dot(x), dot(y), dot(z));
+  EXPECT_NE(slurp(dir / "paper.md").find(expected), std::string::npos) << expected;
   fs::remove_all(dir);
 }
 
