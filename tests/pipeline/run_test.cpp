@@ -69,8 +69,15 @@ TEST(Run, WritesGroundTruthAtEveryFrameTime) {
   const sim::VesselModel model(sc.vessel);
   const Vec3 expected(0 - 0.7, -6.75 + 0.0, model.design_cg_z_m() - 0.45);
   EXPECT_LT((gt[0].T_W_C.translation() - expected).norm(), 1e-12);
-  const Vec3 axis = gt[0].T_W_C.quaternion() * Vec3::UnitZ();  // 30 deg to starboard of north
-  EXPECT_LT((axis - Vec3(std::cos(deg2rad(30)), std::sin(deg2rad(30)), 0)).norm(), 1e-12);
+  // The optical axis: turned by the mount's yaw to starboard of north and pitched by its pitch
+  // (negative: down, +z in NED); its roll turns the image about that axis.
+  const Vec3 axis = gt[0].T_W_C.quaternion() * Vec3::UnitZ();
+  const double pitch = deg2rad(sc.sensors.camera.mount.rpy_deg[1]);
+  const double yaw = deg2rad(sc.sensors.camera.mount.rpy_deg[2]);
+  EXPECT_LT((axis - Vec3(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw),
+                         -std::sin(pitch)))
+                .norm(),
+            1e-12);
   const std::string body = slurp(out / "body_groundtruth.csv");
   EXPECT_EQ(body.rfind("t_ns,north_m,east_m,down_m,qw,qx,qy,qz", 0), 0u);
   // 39 camera periods at 400 Hz: the physics samples up to the first at or after the last
