@@ -253,6 +253,7 @@ struct WaveBasinOptions {
   double beach_distance_m = 3.0;
   double water_depth_m = 0.6;
   double beach_slope_deg = 20.0;
+  bool posters = true;
 
   template <class A>
   void visit(A& a) {
@@ -272,6 +273,11 @@ struct WaveBasinOptions {
       "water.waves.water_depth_m)",
       yaml::positive() & yaml::up_to(100, "deeper than the deepest basin pit"));
     a("beach_slope_deg", beach_slope_deg, "Slope of the beach [deg]", yaml::in_range(5, 60));
+    a("posters", posters,
+      "Printed posters on the walls (A1, about one every 2 m, 40 cm above the water: the "
+      "basin's richest texture, ours: the basin paper shows no walls); false: the painted walls "
+      "with only the windows, pipes, rails, beach and wave generator for a VO to hold to "
+      "(docs/twin-vs-paper.md, \"Plain walls\")");
   }
 };
 

@@ -257,7 +257,7 @@ sim::SceneGeometry build_wave_basin(const WaveBasinOptions& o, Sky /*sky*/, std:
   add_shell(&g, o, B, t);
   const double drive_top = add_generator(&g, o, B, t);
   const WindowBand windows = add_windows(&g, o, t);
-  add_posters(&g, o, B, t, rng, drive_top, windows);
+  if (o.posters) add_posters(&g, o, B, t, rng, drive_top, windows);
   add_pipes_rails_and_mount(&g, o, B, t);
   return g;
 }

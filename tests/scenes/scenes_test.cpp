@@ -311,6 +311,32 @@ TEST(WaveBasin, WellFormedIndoorAndDeterministic) {
   EXPECT_GE(g.water.extent_m, o.beach_distance_m);
 }
 
+// Plain walls: no poster mesh, every other mesh the same vertices as with the posters.
+TEST(WaveBasin, PlainWallsDropThePostersAndKeepEverythingElse) {
+  WaveBasinOptions plain;
+  plain.posters = false;
+  const auto with = build_wave_basin(WaveBasinOptions{}, Sky::kOvercast, kSeed);
+  const auto without = build_wave_basin(plain, Sky::kOvercast, kSeed);
+  expect_well_formed(without);
+  auto is_poster = [](const sim::Mesh& m) { return m.name.rfind("basin_posters", 0) == 0; };
+  std::size_t posters = 0;
+  for (const auto& m : with.meshes) posters += is_poster(m) && !m.vertices.empty();
+  EXPECT_GE(posters, 1u);
+  for (const auto& m : without.meshes) EXPECT_FALSE(is_poster(m)) << m.name;
+  std::size_t kept = 0;
+  for (const auto& m : with.meshes) {
+    if (is_poster(m)) continue;
+    const auto* same = find_mesh(without, m.name);
+    ASSERT_TRUE(same) << m.name;
+    ASSERT_EQ(same->vertices.size(), m.vertices.size()) << m.name;
+    EXPECT_EQ(0, std::memcmp(same->vertices.data(), m.vertices.data(),
+                             m.vertices.size() * sizeof(sim::Vertex)))
+        << m.name;
+    ++kept;
+  }
+  EXPECT_EQ(kept, without.meshes.size());
+}
+
 TEST(WaveBasin, WallsAtHalfWidthAndGeneratorAtZero) {
   WaveBasinOptions o;
   o.width_m = 5.0;
