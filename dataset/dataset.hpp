@@ -47,6 +47,7 @@ struct ImuNoiseModel {
   double gyroscope_random_walk = 0;        ///< rad/s^2/sqrt(Hz)
   double accelerometer_noise_density = 0;  ///< m/s^2/sqrt(Hz)
   double accelerometer_random_walk = 0;    ///< m/s^3/sqrt(Hz)
+  double gravity_m_s2 = 9.80665;           ///< the gravity it measures at rest (standard gravity)
 };
 
 /// One compass heading (driftlab's compass.csv: the sensor x axis's heading, clockwise from

@@ -121,6 +121,9 @@ std::vector<std::pair<std::string, std::string>> vins_fusion_files(const ExportC
                     "   cy: {}\n",
                     i, c.width, c.height, g(c.fx), g(c.fy), g(c.cx), g(c.cy)));
   const ImuNoiseModel& m = cal.imu;
+  // A density sigma_c [unit/sqrt(Hz)] gives sigma_c^2 dt of variance over a sample period dt;
+  // VINS-Fusion's sigma per sample gives sigma^2 dt^2, so sigma = sigma_c / sqrt(dt).
+  const double per_sample = std::sqrt(m.rate_hz);
   files.emplace_back(
       "stereo_imu_config.yaml",
       fmt::format(
@@ -134,14 +137,17 @@ std::vector<std::pair<std::string, std::string>> vins_fusion_files(const ExportC
           "multiple_thread: 1\nmax_cnt: 150\nmin_dist: 30\nfreq: 10\nF_threshold: 1.0\n"
           "show_track: 0\nflow_back: 1\nmax_solver_time: 0.04\nmax_num_iterations: 8\n"
           "keyframe_parallax: 10.0\n"
-          "# the scenario's IMU noise (continuous-time densities; VINS-Fusion's own configs "
-          "inflate them)\nacc_n: {}\ngyr_n: {}\nacc_w: {}\ngyr_w: {}\ng_norm: 9.81\n"
+          "# the scenario's IMU noise per IMU sample, as VINS-Fusion takes it (its preintegration "
+          "adds sigma^2 dt^2 a step): Kalibr's densities times sqrt(rate), {} Hz (VINS-Fusion's "
+          "own configs inflate them); the twin's gravity\nacc_n: {}\ngyr_n: {}\nacc_w: {}\n"
+          "gyr_w: {}\ng_norm: {}\n"
           "estimate_td: 0\ntd: 0.0\nload_previous_pose_graph: 0\n"
           "pose_graph_save_path: \"/tmp/vins_output/pose_graph/\"\nsave_image: 0\n",
           cal.source, names::kImu, names::kImage[0], names::kImage[1], c.width, c.height,
-          opencv_matrix(cal.T_S_C), opencv_matrix(cal.T_S_C * T_C0_C1(cal)),
-          g(m.accelerometer_noise_density), g(m.gyroscope_noise_density),
-          g(m.accelerometer_random_walk), g(m.gyroscope_random_walk)));
+          opencv_matrix(cal.T_S_C), opencv_matrix(cal.T_S_C * T_C0_C1(cal)), g(m.rate_hz),
+          g(m.accelerometer_noise_density * per_sample), g(m.gyroscope_noise_density * per_sample),
+          g(m.accelerometer_random_walk * per_sample), g(m.gyroscope_random_walk * per_sample),
+          g(m.gravity_m_s2)));
   return files;
 }
 

@@ -52,9 +52,12 @@ dataset::ExportCalibration export_calibration(const Scenario& sc) {
   cal.camera_rate_hz = sc.sensors.camera.rate_hz;
   const auto& imu = sc.sensors.imu;
   if (imu.enabled)
-    cal.imu = {imu.rate_hz, imu.gyro_noise_density_rad_s_sqrt_hz,
-               imu.gyro_random_walk_rad_s2_sqrt_hz, imu.accel_noise_density_m_s2_sqrt_hz,
-               imu.accel_random_walk_m_s3_sqrt_hz};
+    cal.imu = {imu.rate_hz,
+               imu.gyro_noise_density_rad_s_sqrt_hz,
+               imu.gyro_random_walk_rad_s2_sqrt_hz,
+               imu.accel_noise_density_m_s2_sqrt_hz,
+               imu.accel_random_walk_m_s3_sqrt_hz,
+               sim::kImuStandardGravity_m_s2};
   cal.source = fmt::format("driftlab scenario '{}', seed {}", sc.name, sc.seed);
   return cal;
 }

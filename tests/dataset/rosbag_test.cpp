@@ -234,7 +234,17 @@ TEST(RosbagExport, PythonsRosbagReadsEveryMessageWithItsStampsAndValues) {
   const Vec3 cam1 = bag_calibration().T_S_C * Vec3(0.25, 0, 0);
   for (int a = 0; a < 3; ++a) EXPECT_NEAR(body_T_cam1.at<double>(a, 3), cam1[a], 1e-15);
   EXPECT_EQ(static_cast<std::string>(vins["image1_topic"]), "/cam1/image_raw");
-  EXPECT_DOUBLE_EQ(static_cast<double>(vins["gyr_n"]), 1.7e-4);
+  // VINS-Fusion takes its noises per IMU sample: over one sample period dt its preintegration
+  // adds sigma^2 dt^2, which must be the variance a Kalibr density gives, density^2 dt.
+  const double dt = 1.0 / bag_calibration().imu.rate_hz;
+  const std::pair<const char*, double> densities[] = {
+      {"gyr_n", 1.7e-4}, {"gyr_w", 2e-5}, {"acc_n", 2e-3}, {"acc_w", 3e-3}};
+  for (const auto& [key, density] : densities) {
+    const double sigma = static_cast<double>(vins[key]);
+    EXPECT_NEAR(sigma * sigma * dt * dt, density * density * dt, 1e-6 * density * density * dt)
+        << key;
+  }
+  EXPECT_DOUBLE_EQ(static_cast<double>(vins["g_norm"]), 9.80665);
   fs::remove_all(root);
 }
 
