@@ -45,6 +45,7 @@ std::string bag_info_yaml(const ExportCalibration& cal, std::size_t frames,
       "world_ned), /tf_static\n"
       "  {}: Kalibr's camera chain (OpenVINS, Kimera; driftlab vo reads it)\n"
       "  {}: Kalibr's IMU noise model\n"
+      "  estimator_config.yaml: OpenVINS's estimator configuration (with an IMU)\n"
       "  vins_fusion/: VINS-Fusion's stereo + IMU configuration and camera files\n"
       "  scenario.resolved.yaml: the scenario that made this dataset\n",
       format == "rosbag" ? "a ROS 1 bag (format 2.0)" : "a ROS 2 bag (sqlite3, CDR)", format,
@@ -152,6 +153,7 @@ void BagWriter::write_calibration_files() const {
   write_file_atomic(root_ / names::kCamchainFile, kalibr_imucam_chain_yaml(cal_));
   if (cal_.imu.rate_hz > 0) {
     write_file_atomic(root_ / names::kImuChainFile, kalibr_imu_chain_yaml(cal_.imu));
+    write_file_atomic(root_ / "estimator_config.yaml", openvins_estimator_config_yaml(cal_));
     fs::create_directories(root_ / "vins_fusion");
     for (const auto& [name, text] : vins_fusion_files(cal_))
       write_file_atomic(root_ / "vins_fusion" / name, text);

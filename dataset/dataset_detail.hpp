@@ -74,7 +74,7 @@ std::string kalibr_imu_chain_yaml(const ImuNoiseModel& imu);
 /// VINS-Fusion's stereo + IMU configuration and its two camera files: (name, text).
 std::vector<std::pair<std::string, std::string>> vins_fusion_files(
     const ExportCalibration& calibration);
-// Basalt's and ORB-SLAM3's settings for a EuRoC export (peer_configs.cpp).
+// Basalt's and ORB-SLAM3's settings for a EuRoC export, OpenVINS's for a bag (peer_configs.cpp).
 /// Basalt's camera calibration (calib.json for basalt_vio --cam-calib): the rectified pair as two
 /// pinholes in the IMU frame, the IMU's Kalibr model (Basalt's defaults without an IMU).
 std::string basalt_calibration_json(const ExportCalibration& calibration);
@@ -82,6 +82,9 @@ std::string basalt_calibration_json(const ExportCalibration& calibration);
 std::string orbslam3_settings_yaml(const ExportCalibration& calibration, bool inertial);
 /// The times file of ORB-SLAM3's EuRoC examples: each image's stamp [ns], its PNG's name.
 std::string orbslam3_times(const std::vector<TimeNs>& stamps);
+/// OpenVINS's estimator_config.yaml beside a bag's Kalibr files: stereo, the IMU as calibrated,
+/// the dynamic initialiser, every key its serial node requires.
+std::string openvins_estimator_config_yaml(const ExportCalibration& calibration);
 /// A Kalibr camera chain's two cameras (pinhole, radtan) and their topics.
 struct KalibrChain {
   std::array<CameraCalibration, 2> cameras;

@@ -287,6 +287,136 @@ TEST(RosbagExport, OpenVinsReaderOpenCvFileStorageReadsTheKalibrChains) {
   fs::remove_all(root);
 }
 
+// The keys OpenVINS's serial node reads from estimator_config.yaml, each required (a missing
+// one stops it), with the type its parser reads: s string, b bool (true/false as a string),
+// i integer, r real (an integer node reads as a real too), v three reals.
+struct OpenVinsKey {
+  const char* key;
+  char type;
+};
+constexpr OpenVinsKey kOpenVinsKeys[] = {{"verbosity", 's'},
+                                         {"use_fej", 'b'},
+                                         {"integration", 's'},
+                                         {"use_stereo", 'b'},
+                                         {"max_cameras", 'i'},
+                                         {"calib_cam_extrinsics", 'b'},
+                                         {"calib_cam_intrinsics", 'b'},
+                                         {"calib_cam_timeoffset", 'b'},
+                                         {"calib_imu_intrinsics", 'b'},
+                                         {"calib_imu_g_sensitivity", 'b'},
+                                         {"max_clones", 'i'},
+                                         {"max_slam", 'i'},
+                                         {"max_slam_in_update", 'i'},
+                                         {"max_msckf_in_update", 'i'},
+                                         {"dt_slam_delay", 'r'},
+                                         {"gravity_mag", 'r'},
+                                         {"feat_rep_msckf", 's'},
+                                         {"feat_rep_slam", 's'},
+                                         {"feat_rep_aruco", 's'},
+                                         {"try_zupt", 'b'},
+                                         {"zupt_chi2_multipler", 'r'},
+                                         {"zupt_max_velocity", 'r'},
+                                         {"zupt_noise_multiplier", 'r'},
+                                         {"zupt_max_disparity", 'r'},
+                                         {"zupt_only_at_beginning", 'b'},
+                                         {"init_window_time", 'r'},
+                                         {"init_imu_thresh", 'r'},
+                                         {"init_max_disparity", 'r'},
+                                         {"init_max_features", 'i'},
+                                         {"init_dyn_use", 'b'},
+                                         {"init_dyn_mle_opt_calib", 'b'},
+                                         {"init_dyn_mle_max_iter", 'i'},
+                                         {"init_dyn_mle_max_threads", 'i'},
+                                         {"init_dyn_mle_max_time", 'r'},
+                                         {"init_dyn_min_deg", 'r'},
+                                         {"init_dyn_num_pose", 'i'},
+                                         {"init_dyn_inflation_ori", 'r'},
+                                         {"init_dyn_inflation_vel", 'r'},
+                                         {"init_dyn_inflation_bg", 'r'},
+                                         {"init_dyn_inflation_ba", 'r'},
+                                         {"init_dyn_min_rec_cond", 'r'},
+                                         {"init_dyn_bias_g", 'v'},
+                                         {"init_dyn_bias_a", 'v'},
+                                         {"record_timing_information", 'b'},
+                                         {"record_timing_filepath", 's'},
+                                         {"use_klt", 'b'},
+                                         {"num_pts", 'i'},
+                                         {"fast_threshold", 'i'},
+                                         {"grid_x", 'i'},
+                                         {"grid_y", 'i'},
+                                         {"min_px_dist", 'i'},
+                                         {"knn_ratio", 'r'},
+                                         {"track_frequency", 'r'},
+                                         {"downsample_cameras", 'b'},
+                                         {"num_opencv_threads", 'i'},
+                                         {"histogram_method", 's'},
+                                         {"use_aruco", 'b'},
+                                         {"num_aruco", 'i'},
+                                         {"downsize_aruco", 'b'},
+                                         {"up_msckf_sigma_px", 'r'},
+                                         {"up_msckf_chi2_multipler", 'r'},
+                                         {"up_slam_sigma_px", 'r'},
+                                         {"up_slam_chi2_multipler", 'r'},
+                                         {"up_aruco_sigma_px", 'r'},
+                                         {"up_aruco_chi2_multipler", 'r'},
+                                         {"use_mask", 'b'},
+                                         {"relative_config_imu", 's'},
+                                         {"relative_config_imucam", 's'}};
+
+TEST(RosbagExport, OpenVinsFindsEveryRequiredKeyOfItsEstimatorConfigWithItsType) {
+  const fs::path root = test::fresh_temp_dir("openvins_config");
+  const BagSequence seq(root / "staging");
+  seq.write(*make_writer(DatasetFormat::kRosbag, root, bag_calibration()));
+  cv::FileStorage config((root / "estimator_config.yaml").string(), cv::FileStorage::READ);
+  ASSERT_TRUE(config.isOpened());
+  ASSERT_EQ(std::size(kOpenVinsKeys), 68u);
+  for (const auto& [key, type] : kOpenVinsKeys) {
+    const cv::FileNode n = config[key];
+    ASSERT_FALSE(n.empty()) << key;
+    switch (type) {
+      case 's':
+        EXPECT_TRUE(n.isString()) << key;
+        break;
+      case 'b': {
+        const std::string b = n.isString() ? static_cast<std::string>(n) : "";
+        EXPECT_TRUE(b == "true" || b == "false") << key << ": " << b;
+        break;
+      }
+      case 'i':
+        EXPECT_TRUE(n.isInt()) << key;
+        break;
+      case 'r':
+        EXPECT_TRUE(n.isReal() || n.isInt()) << key;
+        break;
+      case 'v':
+        ASSERT_TRUE(n.isSeq() && n.size() == 3) << key;
+        for (int a = 0; a < 3; ++a) EXPECT_TRUE(n[a].isReal() || n[a].isInt()) << key;
+        break;
+    }
+  }
+  // Its own checks: an IMU model 'calibrated' with neither IMU calibration on, a stereo pair,
+  // the dynamic initialiser's limits, and the Kalibr files it names, beside it.
+  cv::FileStorage imu((root / static_cast<std::string>(config["relative_config_imu"])).string(),
+                      cv::FileStorage::READ);
+  ASSERT_TRUE(imu.isOpened());
+  EXPECT_EQ(static_cast<std::string>(imu["imu0"]["model"]), "calibrated");
+  EXPECT_EQ(static_cast<std::string>(config["calib_imu_intrinsics"]), "false");
+  EXPECT_EQ(static_cast<std::string>(config["calib_imu_g_sensitivity"]), "false");
+  cv::FileStorage cams((root / static_cast<std::string>(config["relative_config_imucam"])).string(),
+                       cv::FileStorage::READ);
+  ASSERT_TRUE(cams.isOpened());
+  EXPECT_EQ(static_cast<int>(config["max_cameras"]), 2);
+  EXPECT_FALSE(cams["cam1"].empty());
+  EXPECT_GE(static_cast<int>(config["init_max_features"]), 15);
+  EXPECT_GE(static_cast<int>(config["init_dyn_num_pose"]), 4);
+  EXPECT_EQ(static_cast<std::string>(config["integration"]), "rk4");
+  EXPECT_EQ(static_cast<std::string>(config["histogram_method"]), "HISTOGRAM");
+  // No frame is dropped: each comes 1 / rate after the last, later than 1 / track_frequency.
+  EXPECT_GT(static_cast<double>(config["track_frequency"]), bag_calibration().camera_rate_hz);
+  EXPECT_DOUBLE_EQ(static_cast<double>(config["gravity_mag"]), 9.80665);
+  fs::remove_all(root);
+}
+
 TEST(Rosbag2Export, ADecoderOfItsOwnFindsEveryMessageInTheDatabase) {
   const fs::path root = test::fresh_temp_dir("rosbag2_export");
   const BagSequence seq(root / "staging");
