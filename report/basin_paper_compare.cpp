@@ -113,7 +113,9 @@ std::string table(const char* title, const std::string& suffix, const std::vecto
     if (ev.basin_overhead) overhead.rows[e] = twin_row(ev.basin_overhead->rows);
   }
   std::string out = fmt::format("## {} ({})\n\n", title, algo.empty() ? "not in the runs" : algo);
-  out += "| Exp. | waves (γ, ζa, λ) | against | N [cm] | E [cm] | u [cm/s] | v [cm/s] | ψ [°] |\n";
+  out +=
+      "| Exp. | waves (γ, ζa, λ as Table 1 prints it) | against | N [cm] | E [cm] | u [cm/s] | v "
+      "[cm/s] | ψ [°] |\n";
   out += "|---|---|---|---|---|---|---|---|\n";
   for (const int e : exps)
     for (const Source* s : {&paper, &exact, &overhead}) {
@@ -161,7 +163,9 @@ std::string basin_paper_side_by_side(const std::vector<RunRecord>& runs) {
       "# Basin paper (Kučić and Valčić 2020, Tables 2-3) and the twin runs side by side\n\n"
       "RMSE (std) of each filter's errors. The paper measured against its overhead camera, "
       "which tracked a red and a green marker on the model. The twin is measured against the "
-      "exact truth and against that camera, simulated (`sensors.overhead`).\n\n";
+      "exact truth and against that camera, simulated (`sensors.overhead`). The waves are "
+      "Table 1's as it prints them; the shipped scenarios draw its wavelengths as centimetres "
+      "(scenarios/basin_exp4.yaml says why).\n\n";
   out += table("Table 2. Kalman filter", "ned_kf", runs, exps, true);
   out += table("Table 3. Particle filter", "ned_pf", runs, exps, false);
   return out;
