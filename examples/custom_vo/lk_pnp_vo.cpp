@@ -33,18 +33,23 @@ VoResult LkPnpVo::process(const StereoFrame& frame) {
     r.reason = "too few corners";
     return r;
   }
-  std::vector<unsigned char> ok_right, ok_current;
+  std::vector<unsigned char> ok_right, ok_current, ok_back;
   std::vector<float> error;
+  std::vector<cv::Point2f> back_in_left;
   cv::calcOpticalFlowPyrLK(prev_left, prev_right, corners, in_right, ok_right, error);
   cv::calcOpticalFlowPyrLK(prev_left, frame.left, corners, in_current, ok_current, error);
+  // The stereo match followed back into the left image must land where it started: water,
+  // sky and repeated texture give matches that do not.
+  cv::calcOpticalFlowPyrLK(prev_right, prev_left, in_right, back_in_left, ok_back, error);
   // Points of the previous left camera (Z = fx B / disparity) and where they are now.
   const auto& c = rig_.camera;
   std::vector<cv::Point3f> points;
   std::vector<cv::Point2f> pixels;
   for (std::size_t i = 0; i < corners.size(); ++i) {
     const double disparity = corners[i].x - in_right[i].x;
-    if (!ok_right[i] || !ok_current[i] || std::abs(corners[i].y - in_right[i].y) > 1.0 ||
-        disparity < 0.5)
+    if (!ok_right[i] || !ok_current[i] || !ok_back[i] ||
+        std::abs(corners[i].y - in_right[i].y) > 1.0 ||
+        cv::norm(back_in_left[i] - corners[i]) > 0.5 || disparity < 2.0)
       continue;
     const double z = c.fx * rig_.baseline_m / disparity;
     points.emplace_back((corners[i].x - c.cx) * z / c.fx, (corners[i].y - c.cy) * z / c.fy, z);
@@ -59,9 +64,11 @@ VoResult LkPnpVo::process(const StereoFrame& frame) {
   // that the same frames give the same result.
   cv::theRNG().state = rng_.next_u64() | 1;
   const cv::Matx33d K(c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
-  cv::Vec3d rvec, tvec;
+  // From no motion (a frame period moves the camera little): far points constrain the
+  // translation weakly, and the refinement then stays near the motion they allow.
+  cv::Vec3d rvec(0, 0, 0), tvec(0, 0, 0);
   std::vector<int> inliers;
-  if (!cv::solvePnPRansac(points, pixels, K, cv::noArray(), rvec, tvec, false, 200,
+  if (!cv::solvePnPRansac(points, pixels, K, cv::noArray(), rvec, tvec, true, 200,
                           static_cast<float>(options_.ransac_threshold_px), 0.999, inliers) ||
       static_cast<int>(inliers.size()) < options_.min_inliers) {
     r.reason = "PnP failed";
