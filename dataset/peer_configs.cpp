@@ -117,50 +117,80 @@ std::string orbslam3_settings_yaml(const ExportCalibration& cal, bool inertial) 
   return y;
 }
 
+namespace {
+
+const char* const kOpenVinsHead =
+    "%YAML 1.0\n---\n"
+    "# OpenVINS's estimator configuration for this export (ov_msckf: every key below is read, a\n"
+    "# missing one stops the serial node), beside the Kalibr files it names.\n";
+
+// OpenVINS triangulates a feature only within fi_max_dist, fi_max_baseline (its distance over the
+// largest baseline that saw it) and fi_max_cond_number (of the triangulation's 3x3 system, which
+// grows as the square of that ratio). Its defaults, 60 m, 40 and 1e4, are a room's or a drone's:
+// on a river the bank lies 20-100 m from a 0.12 m pair and every feature fails them, so the
+// filter never updates (tried on the crossing: no MSCKF or SLAM feature in 170 frames, then pure
+// IMU drift). Here they reach as far as the pair can see: the depth at half a pixel of disparity.
+std::string openvins_triangulation_yaml(const ExportCalibration& cal) {
+  const double max_depth = cal.rig.camera.fx * cal.rig.baseline_m / 0.5;
+  const double ratio = max_depth / cal.rig.baseline_m;
+  return fmt::format(
+      "# features as far as the pair sees them: the depth at half a pixel of disparity, f B / 0.5 "
+      "px\n# (OpenVINS's defaults, 60 m, 40 and 1e4, reject a river's every feature)\n"
+      "fi_max_dist: {}\nfi_max_baseline: {}\nfi_max_cond_number: {}\n",
+      real(max_depth), real(ratio), real(ratio * ratio));
+}
+
+}  // namespace
+
 std::string openvins_estimator_config_yaml(const ExportCalibration& cal) {
   const std::string r = real(cal.imu.gravity_m_s2);
-  return fmt::format(
-      "%YAML 1.0\n---\n"
-      "# OpenVINS's estimator configuration for this export (ov_msckf: every key below is read, a\n"
-      "# missing one stops the serial node), beside the Kalibr files it names.\n"
-      "verbosity: \"WARNING\"\n"
-      "use_fej: true\nintegration: \"rk4\"\nuse_stereo: true\nmax_cameras: 2\n"
-      "# the export's calibration is exact: nothing to refine online; the IMU is 'calibrated'\n"
-      "# (kalibr_imu_chain.yaml), so its intrinsics and g-sensitivity stay fixed\n"
-      "calib_cam_extrinsics: false\ncalib_cam_intrinsics: false\ncalib_cam_timeoffset: false\n"
-      "calib_imu_intrinsics: false\ncalib_imu_g_sensitivity: false\n"
-      "max_clones: 11\nmax_slam: 50\nmax_slam_in_update: 25\nmax_msckf_in_update: 40\n"
-      "dt_slam_delay: 1.0\n"
-      "# the twin's gravity\ngravity_mag: {}\n"
-      "feat_rep_msckf: \"GLOBAL_3D\"\nfeat_rep_slam: \"ANCHORED_MSCKF_INVERSE_DEPTH\"\n"
-      "feat_rep_aruco: \"ANCHORED_MSCKF_INVERSE_DEPTH\"\n"
-      "try_zupt: false\nzupt_chi2_multipler: 0.0\nzupt_max_velocity: 0.1\n"
-      "zupt_noise_multiplier: 10.0\nzupt_max_disparity: 0.5\nzupt_only_at_beginning: false\n"
-      "# a vessel under way never gives the static initialiser its standstill and jerk: the\n"
-      "# dynamic initialiser instead, which needs some rotation in its window\n"
-      "init_window_time: 2.0\ninit_imu_thresh: 1.5\ninit_max_disparity: 10.0\n"
-      "init_max_features: 50\ninit_dyn_use: true\ninit_dyn_mle_opt_calib: false\n"
-      "init_dyn_mle_max_iter: 50\ninit_dyn_mle_max_threads: 1\ninit_dyn_mle_max_time: 0.05\n"
-      "init_dyn_num_pose: 6\ninit_dyn_min_deg: 10.0\ninit_dyn_inflation_ori: 10.0\n"
-      "init_dyn_inflation_vel: 100.0\ninit_dyn_inflation_bg: 10.0\ninit_dyn_inflation_ba: 100.0\n"
-      "init_dyn_min_rec_cond: 1.0e-12\ninit_dyn_bias_g: [0.0, 0.0, 0.0]\n"
-      "init_dyn_bias_a: [0.0, 0.0, 0.0]\n"
-      "record_timing_information: false\nrecord_timing_filepath: \"/tmp/openvins_timing.txt\"\n"
-      "use_klt: true\nnum_pts: 200\nfast_threshold: 20\ngrid_x: 5\ngrid_y: 5\nmin_px_dist: 10\n"
-      "knn_ratio: 0.7\n"
-      "# a frame earlier than the last tracked one plus 1 / track_frequency is dropped: above the\n"
-      "# camera's {} Hz, so that none is\ntrack_frequency: {}\n"
-      "downsample_cameras: false\n"
-      "# OpenCV on one thread, for runs that repeat\nnum_opencv_threads: 0\n"
-      "multi_threading_pubs: false\n"
-      "histogram_method: \"HISTOGRAM\"\n"
-      "use_aruco: false\nnum_aruco: 1024\ndownsize_aruco: true\n"
-      "up_msckf_sigma_px: 1.0\nup_msckf_chi2_multipler: 1.0\nup_slam_sigma_px: 1.0\n"
-      "up_slam_chi2_multipler: 1.0\nup_aruco_sigma_px: 1.0\nup_aruco_chi2_multipler: 1.0\n"
-      "use_mask: false\n"
-      "relative_config_imu: \"{}\"\nrelative_config_imucam: \"{}\"\n",
-      r, real(cal.camera_rate_hz), real(cal.camera_rate_hz + 1), rosbag_names::kImuChainFile,
-      rosbag_names::kCamchainFile);
+  return kOpenVinsHead + openvins_triangulation_yaml(cal) +
+         fmt::format(
+             "verbosity: \"WARNING\"\n"
+             "use_fej: true\nintegration: \"rk4\"\nuse_stereo: true\nmax_cameras: 2\n"
+             "# the export's calibration is exact: nothing to refine online; the IMU is "
+             "'calibrated'\n"
+             "# (kalibr_imu_chain.yaml), so its intrinsics and g-sensitivity stay fixed\n"
+             "calib_cam_extrinsics: false\ncalib_cam_intrinsics: false\ncalib_cam_timeoffset: "
+             "false\n"
+             "calib_imu_intrinsics: false\ncalib_imu_g_sensitivity: false\n"
+             "max_clones: 11\nmax_slam: 50\nmax_slam_in_update: 25\nmax_msckf_in_update: 40\n"
+             "dt_slam_delay: 1.0\n"
+             "# the twin's gravity\ngravity_mag: {}\n"
+             "feat_rep_msckf: \"GLOBAL_3D\"\nfeat_rep_slam: \"ANCHORED_MSCKF_INVERSE_DEPTH\"\n"
+             "feat_rep_aruco: \"ANCHORED_MSCKF_INVERSE_DEPTH\"\n"
+             "try_zupt: false\nzupt_chi2_multipler: 0.0\nzupt_max_velocity: 0.1\n"
+             "zupt_noise_multiplier: 10.0\nzupt_max_disparity: 0.5\nzupt_only_at_beginning: false\n"
+             "# a vessel under way never gives the static initialiser its standstill and jerk: "
+             "the\n"
+             "# dynamic initialiser instead, which needs some rotation in its window\n"
+             "init_window_time: 2.0\ninit_imu_thresh: 1.5\ninit_max_disparity: 10.0\n"
+             "init_max_features: 50\ninit_dyn_use: true\ninit_dyn_mle_opt_calib: false\n"
+             "init_dyn_mle_max_iter: 50\ninit_dyn_mle_max_threads: 1\ninit_dyn_mle_max_time: 0.05\n"
+             "init_dyn_num_pose: 6\ninit_dyn_min_deg: 10.0\ninit_dyn_inflation_ori: 10.0\n"
+             "init_dyn_inflation_vel: 100.0\ninit_dyn_inflation_bg: 10.0\ninit_dyn_inflation_ba: "
+             "100.0\n"
+             "init_dyn_min_rec_cond: 1.0e-12\ninit_dyn_bias_g: [0.0, 0.0, 0.0]\n"
+             "init_dyn_bias_a: [0.0, 0.0, 0.0]\n"
+             "record_timing_information: false\nrecord_timing_filepath: "
+             "\"/tmp/openvins_timing.txt\"\n"
+             "use_klt: true\nnum_pts: 200\nfast_threshold: 20\ngrid_x: 5\ngrid_y: 5\nmin_px_dist: "
+             "10\n"
+             "knn_ratio: 0.7\n"
+             "# a frame earlier than the last tracked one plus 1 / track_frequency is dropped: "
+             "above the\n"
+             "# camera's {} Hz, so that none is\ntrack_frequency: {}\n"
+             "downsample_cameras: false\n"
+             "# OpenCV on one thread, for runs that repeat\nnum_opencv_threads: 0\n"
+             "multi_threading_pubs: false\n"
+             "histogram_method: \"HISTOGRAM\"\n"
+             "use_aruco: false\nnum_aruco: 1024\ndownsize_aruco: true\n"
+             "up_msckf_sigma_px: 1.0\nup_msckf_chi2_multipler: 1.0\nup_slam_sigma_px: 1.0\n"
+             "up_slam_chi2_multipler: 1.0\nup_aruco_sigma_px: 1.0\nup_aruco_chi2_multipler: 1.0\n"
+             "use_mask: false\n"
+             "relative_config_imu: \"{}\"\nrelative_config_imucam: \"{}\"\n",
+             r, real(cal.camera_rate_hz), real(cal.camera_rate_hz + 1), rosbag_names::kImuChainFile,
+             rosbag_names::kCamchainFile);
 }
 
 std::string orbslam3_times(const std::vector<TimeNs>& stamps) {

@@ -7,6 +7,8 @@
 #include <cctype>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
+#include <iterator>
 #include <numbers>
 #include <optional>
 #include <string_view>
@@ -145,7 +147,28 @@ struct ExternalVoStage::Export {
   }
   fs::path out() const { return folder / ("trajectory." + extension(options.output)); }
 
-  // The command's trajectory as left-camera poses anchored at the true first pose.
+  // The exported frame whose stamp is nearest `t_ns`: a VO that initialises after some frames
+  // (a stereo-inertial one waits for motion) starts its trajectory there, not at the first.
+  const StampedPose& truth_at(TimeNs t_ns) const {
+    const auto later = std::lower_bound(truth.begin(), truth.end(), t_ns,
+                                        [](const StampedPose& p, TimeNs t) { return p.t_ns < t; });
+    auto nearest = later == truth.end() ? std::prev(later) : later;
+    if (later != truth.begin() && later != truth.end() &&
+        t_ns - std::prev(later)->t_ns <= later->t_ns - t_ns)
+      nearest = std::prev(later);
+    const TimeNs period = truth.size() > 1 ? (truth.back().t_ns - truth.front().t_ns) /
+                                                 static_cast<TimeNs>(truth.size() - 1)
+                                           : 0;
+    if (std::abs(nearest->t_ns - t_ns) > period)
+      throw UserError(fmt::format(
+          "{}: its first pose at t = {} ns is more than a frame from every exported frame "
+          "({} to {} ns)",
+          out().string(), t_ns, truth.front().t_ns, truth.back().t_ns));
+    return *nearest;
+  }
+
+  // The command's trajectory as left-camera poses, its first anchored at the true pose of the
+  // frame it belongs to.
   Trajectory read_estimate() const {
     Trajectory raw;
     if (options.output == TrajectoryFormat::kKitti) {
@@ -158,7 +181,7 @@ struct ExternalVoStage::Export {
     if (raw.empty()) throw UserError(out().string() + ": no poses");
     if (options.output == TrajectoryFormat::kEuroc)  // body (IMU) poses
       for (auto& p : raw) p.T_W_C = p.T_W_C * calibration.T_S_C;
-    const SE3 anchor = truth.front().T_W_C * raw.front().T_W_C.inverse();
+    const SE3 anchor = truth_at(raw.front().t_ns).T_W_C * raw.front().T_W_C.inverse();
     for (auto& p : raw) p.T_W_C = anchor * p.T_W_C;
     return raw;
   }

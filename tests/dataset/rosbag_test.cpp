@@ -414,6 +414,15 @@ TEST(RosbagExport, OpenVinsFindsEveryRequiredKeyOfItsEstimatorConfigWithItsType)
   // No frame is dropped: each comes 1 / rate after the last, later than 1 / track_frequency.
   EXPECT_GT(static_cast<double>(config["track_frequency"]), bag_calibration().camera_rate_hz);
   EXPECT_DOUBLE_EQ(static_cast<double>(config["gravity_mag"]), 9.80665);
+  // Its feature triangulation reaches the depth at half a pixel of stereo disparity, f B / 0.5:
+  // a feature at that depth seen by the pair alone passes the distance, the distance over
+  // baseline and (growing as its square) the condition number gates.
+  const auto& cal = bag_calibration();
+  const double depth = cal.rig.camera.fx * cal.rig.baseline_m / 0.5;
+  EXPECT_NEAR(static_cast<double>(config["fi_max_dist"]), depth, 1e-9 * depth);
+  EXPECT_NEAR(static_cast<double>(config["fi_max_baseline"]), depth / cal.rig.baseline_m, 1e-6);
+  EXPECT_NEAR(static_cast<double>(config["fi_max_cond_number"]),
+              std::pow(depth / cal.rig.baseline_m, 2), 1e-3);
   fs::remove_all(root);
 }
 

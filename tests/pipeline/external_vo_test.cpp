@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -117,7 +118,8 @@ TEST(ExternalVo, RealFailingHangingAndGarbageCommandsAreEachRecorded) {
       script("driftlab_sparse.sh") +
       " {driftlab} {dir} {root} {out} rosbag'}, {name: mine_ros2, format: rosbag2, output: tum, "
       "command: 'test -f {dir}/rosbag2/metadata.yaml && test -f {dir}/rosbag2/rosbag2_0.db3 && "
-      "cp {root}/../../mine/trajectory.tum {out}'}]";
+      "cp {root}/../../mine/trajectory.tum {out}'}, {name: late, command: 'tail -n +6 "
+      "{root}/../../mine/trajectory.tum > {out}'}]";
   const auto t0 = std::chrono::steady_clock::now();
   const auto r = test::run_cli(
       {"run", (test::source_dir() / "scenarios/river_crossing.yaml").string(), "--set",
@@ -167,11 +169,72 @@ TEST(ExternalVo, RealFailingHangingAndGarbageCommandsAreEachRecorded) {
   EXPECT_LT(largest_difference(read_tum(out / "estimates/mine_bag.tum"),
                                read_tum(out / "estimates/sparse.tum")),
             1e-9);
+  // A VO that starts at the sixth frame (a stereo-inertial one initialising) is anchored at
+  // that frame's true pose, not at the first's.
+  EXPECT_EQ(ext["late"]["status"], "ok") << ext["late"];
+  {
+    // mine's poses are its raw ones anchored at the first frame; late's the same raw poses from
+    // its first stamp on, anchored there: truth(t_k) mine_k^-1 mine_j.
+    const Trajectory mine = read_tum(out / "estimates/mine.tum");
+    const Trajectory late = read_tum(out / "estimates/late.tum");
+    const Trajectory truth = read_tum(out / "groundtruth.tum");
+    ASSERT_GT(late.size(), 3U);
+    const auto at = [&](const Trajectory& t, TimeNs stamp) {
+      const auto p =
+          std::find_if(t.begin(), t.end(), [&](const StampedPose& q) { return q.t_ns == stamp; });
+      EXPECT_NE(p, t.end()) << stamp;
+      return static_cast<std::size_t>(p - t.begin());
+    };
+    const std::size_t k = at(mine, late.front().t_ns);
+    EXPECT_GT(k, 0U);  // it does start later than mine
+    Trajectory expected(mine.begin() + static_cast<std::ptrdiff_t>(k), mine.end());
+    const SE3 anchor = truth[at(truth, late.front().t_ns)].T_W_C * mine[k].T_W_C.inverse();
+    for (auto& p : expected) p.T_W_C = anchor * p.T_W_C;
+    EXPECT_LT(largest_difference(late, expected), 1e-9);
+  }
   EXPECT_NE(slurp(out / "report.md").find("| stuck | timeout | exit code 124 |"),
             std::string::npos);
   // The datasets are removed after the commands (keep_dataset: false); the logs stay.
   EXPECT_FALSE(fs::exists(out / "external/mine/dataset"));
   EXPECT_TRUE(fs::exists(out / "external/broken/log.txt"));
+  fs::remove_all(out);
+}
+
+// The peers' runners (examples/external/*.sh), as the README runs them, with each system's
+// program replaced by a stand-in (tests/data/peers/) that reads the files the export hands it
+// as that system does and writes the system's own trajectory format from the true poses, in a
+// world frame of its own: driftlab must read every one back as the truth.
+TEST(ExternalVo, EachPeersRunnerReadsItsSystemsTrajectoryFormatAsTheTruth) {
+  const fs::path out = test::unused_temp_path("external_vo_peers");
+  const fs::path peers = test::source_dir() / "tests/data/peers";
+  const auto r = test::run_shell(
+      "cd " + test::shell_quote(test::source_dir().string()) +
+      " && DRIFTLAB_OPENVINS=" + test::shell_quote((peers / "openvins").string()) +
+      " DRIFTLAB_VINS_FUSION=" + test::shell_quote((peers / "vins-fusion").string()) +
+      " DRIFTLAB_BASALT=" + test::shell_quote((peers / "basalt").string()) + " " +
+      test::shell_quote(test::cli_path().string()) +
+      " run scenarios/river_crossing.yaml --set pipeline.max_frames=12 --set "
+      "\"pipeline.external_vo=$(cat examples/external/openvins.yaml "
+      "examples/external/vins-fusion.yaml examples/external/basalt.yaml)\" --out " +
+      test::shell_quote(out.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto m = nlohmann::json::parse(slurp(out / "metrics.json"));
+  const Trajectory truth = read_tum(out / "groundtruth.tum");
+  for (const char* name :
+       {"openvins", "vins_fusion_imu", "vins_fusion", "basalt_vio", "basalt_vo"}) {
+    SCOPED_TRACE(name);
+    ASSERT_EQ(m["external_vo"][name]["status"], "ok") << m["external_vo"][name];
+    const Trajectory estimate = read_tum(out / "estimates" / (std::string(name) + ".tum"));
+    ASSERT_EQ(estimate.size(), truth.size());
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      // OpenVINS writes seconds with 5 decimals: its stamps are the frames' to 5 us.
+      EXPECT_LE(std::abs(estimate[i].t_ns - truth[i].t_ns), 5000);
+      // The systems' own precision: 5 decimals (VINS-Fusion) over a few metres of lever.
+      const SE3 d = truth[i].T_W_C.inverse() * estimate[i].T_W_C;
+      EXPECT_LT(d.translation().norm(), 2e-3);
+      EXPECT_LT(Eigen::AngleAxisd(d.quaternion()).angle(), 1e-4);
+    }
+  }
   fs::remove_all(out);
 }
 
