@@ -134,7 +134,9 @@ std::vector<std::pair<std::string, std::string>> vins_fusion_files(const ExportC
           "image_width: {}\nimage_height: {}\n"
           "# the cameras in the body (IMU) frame, known exactly\nestimate_extrinsic: 0\n"
           "body_T_cam0: {}body_T_cam1: {}"
-          "multiple_thread: 1\nmax_cnt: 150\nmin_dist: 30\nfreq: 10\nF_threshold: 1.0\n"
+          "# 1 would hand the estimator every second image (estimator.cpp's inputImageCnt % 2),\n"
+          "# VINS-Fusion's EuRoC setting for a 20 Hz camera: below 20 Hz every image, one thread\n"
+          "multiple_thread: {}\nmax_cnt: 150\nmin_dist: 30\nfreq: 10\nF_threshold: 1.0\n"
           "show_track: 0\nflow_back: 1\nmax_solver_time: 0.04\nmax_num_iterations: 8\n"
           "keyframe_parallax: 10.0\n"
           "# the scenario's IMU noise per IMU sample, as VINS-Fusion takes it (its preintegration "
@@ -144,7 +146,8 @@ std::vector<std::pair<std::string, std::string>> vins_fusion_files(const ExportC
           "estimate_td: 0\ntd: 0.0\nload_previous_pose_graph: 0\n"
           "pose_graph_save_path: \"/tmp/vins_output/pose_graph/\"\nsave_image: 0\n",
           cal.source, names::kImu, names::kImage[0], names::kImage[1], c.width, c.height,
-          opencv_matrix(cal.T_S_C), opencv_matrix(cal.T_S_C * T_C0_C1(cal)), g(m.rate_hz),
+          opencv_matrix(cal.T_S_C), opencv_matrix(cal.T_S_C * T_C0_C1(cal)),
+          cal.camera_rate_hz >= 20 ? 1 : 0, g(m.rate_hz),
           g(m.accelerometer_noise_density * per_sample), g(m.gyroscope_noise_density * per_sample),
           g(m.accelerometer_random_walk * per_sample), g(m.gyroscope_random_walk * per_sample),
           g(m.gravity_m_s2)));

@@ -27,7 +27,8 @@ peer_packages() {
 
 # peer_copy SOURCE DEST FIX: copies SOURCE to DEST with the function FIX applied to the copy
 # (run in the copy's folder). Files whose content did not change keep their times, so a second
-# build rebuilds only what changed.
+# build rebuilds only what changed; a changed one is written now (not with its source's time,
+# which can be older than its object file).
 peer_copy() {
   local src=$1 dest=$2 fix=$3 stage
   mkdir -p "$(dirname "$dest")"
@@ -35,7 +36,7 @@ peer_copy() {
   cp -a "$src/." "$stage/"
   (cd "$stage" && "$fix")
   mkdir -p "$dest"
-  rsync -a --checksum --delete "$stage/" "$dest/"
+  rsync --recursive --links --perms --checksum --delete "$stage/" "$dest/"
   rm -rf "$stage"
 }
 

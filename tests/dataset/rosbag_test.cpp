@@ -245,6 +245,10 @@ TEST(RosbagExport, PythonsRosbagReadsEveryMessageWithItsStampsAndValues) {
         << key;
   }
   EXPECT_DOUBLE_EQ(static_cast<double>(vins["g_norm"]), 9.80665);
+  // With multiple_thread: 1 its estimator takes every second image (estimator.cpp,
+  // inputImageCnt % 2): at 10 Hz, one thread and every image.
+  ASSERT_LT(bag_calibration().camera_rate_hz, 20);
+  EXPECT_EQ(static_cast<int>(vins["multiple_thread"]), 0);
   fs::remove_all(root);
 }
 
