@@ -11,10 +11,8 @@
 set -euo pipefail
 root=$1 out=$2
 ws=${DRIFTLAB_OPENVINS:-$HOME/.cache/driftlab/peers/openvins}
-[ -f "$ws/devel/setup.bash" ] || {
-  echo "openvins.sh: $ws/devel/setup.bash: not found; build OpenVINS with scripts/external/openvins" >&2
-  exit 2
-}
+source "$(dirname "$0")/runner.sh"
+peer_built "$ws/devel/setup.bash" OpenVINS openvins
 set +u
 source "$ws/devel/setup.bash"
 set -u

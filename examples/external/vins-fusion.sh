@@ -13,15 +13,9 @@
 set -euo pipefail
 root=$1 out=$2 mode=${3:-stereo_imu} rate=${4:-1}
 ws=${DRIFTLAB_VINS_FUSION:-$HOME/.cache/driftlab/peers/vins-fusion}
-[ -f "$ws/devel/setup.bash" ] || {
-  echo "vins-fusion.sh: $ws/devel/setup.bash: not found; build VINS-Fusion with scripts/external/vins-fusion" >&2
-  exit 2
-}
-case "$mode" in
-  stereo_imu) imu=1 ;;
-  stereo) imu=0 ;;
-  *) echo "vins-fusion.sh: mode '$mode': expected stereo_imu or stereo" >&2; exit 2 ;;
-esac
+source "$(dirname "$0")/runner.sh"
+peer_built "$ws/devel/setup.bash" VINS-Fusion vins-fusion
+imu=$(with_imu "$mode" stereo_imu stereo)
 set +u
 source "$ws/devel/setup.bash"
 set -u
