@@ -19,6 +19,10 @@ dir=$1 out=$2 mode=${3:-vio} config=${4:-kitti_config.json}
 build=${DRIFTLAB_BASALT:-$HOME/.cache/driftlab/peers/basalt}
 source "$(dirname "$0")/runner.sh"
 peer_built "$build/build/basalt_vio" Basalt basalt
+[ -f "$build/src/data/$config" ] || {
+  echo "basalt.sh: CONFIG '$config': no such file in $build/src/data (expected one of Basalt's configurations, e.g. kitti_config.json)" >&2
+  exit 2
+}
 imu=$(with_imu "$mode" vio vo)
 work=$(dirname "$out")/basalt
 rm -rf "$work"

@@ -238,5 +238,23 @@ TEST(ExternalVo, EachPeersRunnerReadsItsSystemsTrajectoryFormatAsTheTruth) {
   fs::remove_all(out);
 }
 
+// A runner handed a configuration its system does not have stops before running it, names the
+// file, and writes no trajectory.
+TEST(ExternalVo, BasaltsRunnerRefusesAConfigurationBasaltDoesNotHave) {
+  const fs::path out = test::unused_temp_path("external_vo_basalt_config");
+  fs::create_directories(out);
+  const fs::path peers = test::source_dir() / "tests/data/peers";
+  const auto r = test::run_shell(
+      "cd " + test::shell_quote(test::source_dir().string()) +
+      " && DRIFTLAB_BASALT=" + test::shell_quote((peers / "basalt").string()) +
+      " bash examples/external/basalt.sh /nonexistent " +
+      test::shell_quote((out / "trajectory.csv").string()) + " vio euroc_configg.json");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("CONFIG 'euroc_configg.json': no such file"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(out / "trajectory.csv"));
+  fs::remove_all(out);
+}
+
 }  // namespace
 }  // namespace driftlab::pipeline
