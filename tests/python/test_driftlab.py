@@ -178,3 +178,65 @@ def test_render_gives_the_pngs_of_driftlab_render_byte_for_byte(tmp_path):
             assert image.tobytes() == png.tobytes()
         pfm = cv2.imread(str(tmp_path / "pngs" / "depth" / f"{f.k:06d}.pfm"), cv2.IMREAD_UNCHANGED)
         assert f.depth.dtype == numpy.float32 and f.depth.tobytes() == pfm.tobytes()
+
+
+def ablation_spec(tmp_path, mechanisms):
+    spec = {
+        "scenarios": {"tiny": {"path": TINY, "set": {"pipeline.max_frames": 6}}},
+        "set": {"pipeline.fusion": []},
+        "baseline": {"sensors.camera.mount.rpy_deg": [0, 0, 0], "scene.river_reach.buildings": 1},
+        "mechanisms": mechanisms,
+        "metrics": [{"label": "APE [cm]", "path": "algorithms.sparse.ape.trans_m.rmse",
+                     "scale": 100},
+                    {"label": "frames", "path": "frames"},
+                    {"label": "dense APE [m]", "path": "algorithms.dense.ape.trans_m.rmse"}],
+    }
+    path = tmp_path / "spec.yaml"
+    path.write_text(json.dumps(spec))  # JSON is YAML
+    return path
+
+
+def test_the_ablation_example_runs_none_each_mechanism_and_all(tmp_path):
+    example = os.path.join(SOURCE, "examples", "ablation", "ablation.py")
+    spec = ablation_spec(tmp_path, {
+        "tilt": {"set": {"sensors.camera.mount.rpy_deg": [0, -10, 0]}},
+        "town": {"set": {"scene.river_reach.buildings": 3}}})
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, example, str(spec), "--out", str(out)],
+                          check=True, capture_output=True, text=True)
+    expected = {"none": ([0, 0, 0], 1), "tilt": ([0, -10, 0], 1), "town": ([0, 0, 0], 3),
+                "all": ([0, -10, 0], 3)}
+    table = (out / "ablation.md").read_text()
+    for variant, (rpy, buildings) in expected.items():
+        run = out / "tiny" / variant
+        resolved = driftlab.Scenario.load(run / "scenario.resolved.yaml")
+        assert resolved.to_yaml() == (run / "scenario.resolved.yaml").read_text()
+        written = json.loads((run / "metrics.json").read_text())
+        assert written["frames"] == 6
+        ape = written["algorithms"]["sparse"]["ape"]["trans_m"]["rmse"] * 100
+        # the dense VO did not run: its cell is a dash
+        assert f"| {variant} | {ape:.2f} / {6:.2f} / — |" in table or \
+            f"| {variant} | {ape:.3f} / {6:.2f} / — |" in table
+        text = (run / "scenario.resolved.yaml").read_text()
+        assert f"rpy_deg: [{', '.join(str(v) for v in rpy)}]" in text
+        assert f"buildings: {buildings}" in text
+    with open(out / "ablation.csv") as f:
+        assert len(list(csv.DictReader(f))) == 4 * 3
+    # Run again: every run's resolved scenario is the one asked for, so each is read back.
+    stamps = {v: (out / "tiny" / v / "metrics.json").stat().st_mtime_ns for v in expected}
+    again = subprocess.run([sys.executable, example, str(spec), "--out", str(out)],
+                           check=True, capture_output=True, text=True)
+    assert again.stdout.count("(read back)") == 4
+    assert stamps == {v: (out / "tiny" / v / "metrics.json").stat().st_mtime_ns for v in expected}
+    assert (out / "ablation.md").read_text() == table
+    assert done.stdout.endswith(table)
+
+
+def test_the_ablation_example_refuses_a_mechanism_without_an_off_value(tmp_path):
+    example = os.path.join(SOURCE, "examples", "ablation", "ablation.py")
+    spec = ablation_spec(tmp_path, {"wind": {"set": {"water.wind.speed_mps": 4}}})
+    done = subprocess.run([sys.executable, example, str(spec), "--out", str(tmp_path / "out")],
+                          capture_output=True, text=True)
+    assert done.returncode != 0
+    assert "mechanisms.wind.set.water.wind.speed_mps: not in baseline" in done.stderr
+    assert not (tmp_path / "out").exists()
