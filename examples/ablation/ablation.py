@@ -27,13 +27,23 @@ NONE, ALL = "none", "all"
 
 
 def load_spec(path):
-    """The spec, checked: every mechanism sets keys the baseline turns off, no key twice."""
-    with open(path) as f:
-        spec = yaml.safe_load(f)
+    """The spec, checked: every mechanism sets keys the baseline turns off, no key twice, and
+    every metric is a number of the run record."""
+    try:
+        with open(path) as f:
+            spec = yaml.safe_load(f)
+    except (OSError, yaml.YAMLError) as e:
+        raise SystemExit(f"{path}: {e}")
+    if not isinstance(spec, dict):
+        raise SystemExit(f"{path}: expected a mapping of scenarios, baseline, mechanisms, metrics")
     for field in ("scenarios", "baseline", "mechanisms", "metrics"):
         if not spec.get(field):
             raise SystemExit(f"{path}: field '{field}': missing or empty; expected a mapping "
                              "(see examples/ablation/ablation.py)")
+    for name, entry in spec["scenarios"].items():
+        if not isinstance(entry, dict) or not entry.get("path"):
+            raise SystemExit(f"{path}: scenarios.{name}: got {entry!r}; expected "
+                             "{path: SCENARIO.yaml, set: {...}}")
     seen = {}
     for name, mechanism in spec["mechanisms"].items():
         if name in (NONE, ALL):
@@ -47,7 +57,21 @@ def load_spec(path):
                 raise SystemExit(f"{path}: mechanisms.{name}.set.{key}: also set by mechanism "
                                  f"'{seen[key]}'; 'all' could not hold both")
             seen[key] = name
+    check_metrics(path, spec["metrics"])
     return spec
+
+
+def check_metrics(path, metrics):
+    """Each metric's path is a number of metrics.json (the metrics reference; NAME matches any
+    algorithm's or track's name)."""
+    numbers = [f.split(".") for f, kind, _ in driftlab.fields("run")
+               if kind.startswith("number") or kind.startswith("integer")]
+    for i, metric in enumerate(metrics):
+        parts = str(metric.get("path", "")).split(".")
+        if not any(len(f) == len(parts) and all(a in ("NAME", b) for a, b in zip(f, parts))
+                   for f in numbers):
+            raise SystemExit(f"{path}: metrics[{i}].path: got '{metric.get('path')}'; expected "
+                             "the path of a number in metrics.json (docs/metrics-reference.md)")
 
 
 def variants(spec):
@@ -112,6 +136,14 @@ def main():
     p.add_argument("--only", action="append", help="run only this scenario (repeatable)")
     a = p.parse_args()
     spec = load_spec(a.spec)
+    try:
+        run_all(a, spec)
+    except driftlab.Error as e:
+        raise SystemExit(str(e))
+
+
+def run_all(a, spec):
+    """Every run of the spec (or of --only's scenarios), then the table and the CSV."""
     for name in a.only or []:
         if name not in spec["scenarios"]:
             raise SystemExit(f"{a.spec}: --only {name}: no such scenario; expected one of "

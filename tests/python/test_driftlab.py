@@ -240,3 +240,27 @@ def test_the_ablation_example_refuses_a_mechanism_without_an_off_value(tmp_path)
     assert done.returncode != 0
     assert "mechanisms.wind.set.water.wind.speed_mps: not in baseline" in done.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_the_ablation_example_refuses_a_metric_that_is_not_a_number_of_the_record(tmp_path):
+    example = os.path.join(SOURCE, "examples", "ablation", "ablation.py")
+    spec = ablation_spec(tmp_path, {"tilt": {"set": {"sensors.camera.mount.rpy_deg": [0, -5, 0]}}})
+    text = json.loads(spec.read_text())
+    text["metrics"][0]["path"] = "algorithms.sparse.ape.trans_m.rsme"
+    spec.write_text(json.dumps(text))
+    done = subprocess.run([sys.executable, example, str(spec), "--out", str(tmp_path / "out")],
+                          capture_output=True, text=True)
+    assert done.returncode != 0
+    assert "metrics[0].path: got 'algorithms.sparse.ape.trans_m.rsme'" in done.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_ablation_example_reports_a_bad_scenario_key_as_the_cli_does(tmp_path):
+    example = os.path.join(SOURCE, "examples", "ablation", "ablation.py")
+    spec = ablation_spec(tmp_path, {"fast": {"set": {"sensors.camera.mount.rpy_deg": [0, 999, 0]}}})
+    done = subprocess.run([sys.executable, example, str(spec), "--out", str(tmp_path / "out")],
+                          capture_output=True, text=True)
+    assert done.returncode != 0
+    assert "sensors.camera.mount.rpy_deg" in done.stderr and "999" in done.stderr
+    assert "Traceback" not in done.stderr
+    assert not (tmp_path / "out" / "tiny" / "fast").exists()
