@@ -180,6 +180,13 @@ def test_render_gives_the_pngs_of_driftlab_render_byte_for_byte(tmp_path):
         assert f.depth.dtype == numpy.float32 and f.depth.tobytes() == pfm.tobytes()
 
 
+def ablate(spec, out, check=False):
+    """examples/ablation/ablation.py on a spec, as a user runs it."""
+    example = os.path.join(SOURCE, "examples", "ablation", "ablation.py")
+    return subprocess.run([sys.executable, example, str(spec), "--out", str(out)], check=check,
+                          capture_output=True, text=True)
+
+
 def ablation_spec(tmp_path, mechanisms):
     spec = {
         "scenarios": {"tiny": {"path": TINY, "set": {"pipeline.max_frames": 6}}},
@@ -197,13 +204,11 @@ def ablation_spec(tmp_path, mechanisms):
 
 
 def test_the_ablation_example_runs_none_each_mechanism_and_all(tmp_path):
-    example = os.path.join(SOURCE, "examples", "ablation", "ablation.py")
     spec = ablation_spec(tmp_path, {
         "tilt": {"set": {"sensors.camera.mount.rpy_deg": [0, -10, 0]}},
         "town": {"set": {"scene.river_reach.buildings": 3}}})
     out = tmp_path / "out"
-    done = subprocess.run([sys.executable, example, str(spec), "--out", str(out)],
-                          check=True, capture_output=True, text=True)
+    done = ablate(spec, out, check=True)
     expected = {"none": ([0, 0, 0], 1), "tilt": ([0, -10, 0], 1), "town": ([0, 0, 0], 3),
                 "all": ([0, -10, 0], 3)}
     table = (out / "ablation.md").read_text()
@@ -224,8 +229,7 @@ def test_the_ablation_example_runs_none_each_mechanism_and_all(tmp_path):
         assert len(list(csv.DictReader(f))) == 4 * 3
     # Run again: every run's resolved scenario is the one asked for, so each is read back.
     stamps = {v: (out / "tiny" / v / "metrics.json").stat().st_mtime_ns for v in expected}
-    again = subprocess.run([sys.executable, example, str(spec), "--out", str(out)],
-                           check=True, capture_output=True, text=True)
+    again = ablate(spec, out, check=True)
     assert again.stdout.count("(read back)") == 4
     assert stamps == {v: (out / "tiny" / v / "metrics.json").stat().st_mtime_ns for v in expected}
     assert (out / "ablation.md").read_text() == table
@@ -233,33 +237,27 @@ def test_the_ablation_example_runs_none_each_mechanism_and_all(tmp_path):
 
 
 def test_the_ablation_example_refuses_a_mechanism_without_an_off_value(tmp_path):
-    example = os.path.join(SOURCE, "examples", "ablation", "ablation.py")
     spec = ablation_spec(tmp_path, {"wind": {"set": {"water.wind.speed_mps": 4}}})
-    done = subprocess.run([sys.executable, example, str(spec), "--out", str(tmp_path / "out")],
-                          capture_output=True, text=True)
+    done = ablate(spec, tmp_path / "out")
     assert done.returncode != 0
     assert "mechanisms.wind.set.water.wind.speed_mps: not in baseline" in done.stderr
     assert not (tmp_path / "out").exists()
 
 
 def test_the_ablation_example_refuses_a_metric_that_is_not_a_number_of_the_record(tmp_path):
-    example = os.path.join(SOURCE, "examples", "ablation", "ablation.py")
     spec = ablation_spec(tmp_path, {"tilt": {"set": {"sensors.camera.mount.rpy_deg": [0, -5, 0]}}})
     text = json.loads(spec.read_text())
     text["metrics"][0]["path"] = "algorithms.sparse.ape.trans_m.rsme"
     spec.write_text(json.dumps(text))
-    done = subprocess.run([sys.executable, example, str(spec), "--out", str(tmp_path / "out")],
-                          capture_output=True, text=True)
+    done = ablate(spec, tmp_path / "out")
     assert done.returncode != 0
     assert "metrics[0].path: got 'algorithms.sparse.ape.trans_m.rsme'" in done.stderr
     assert not (tmp_path / "out").exists()
 
 
 def test_the_ablation_example_reports_a_bad_scenario_key_as_the_cli_does(tmp_path):
-    example = os.path.join(SOURCE, "examples", "ablation", "ablation.py")
     spec = ablation_spec(tmp_path, {"fast": {"set": {"sensors.camera.mount.rpy_deg": [0, 999, 0]}}})
-    done = subprocess.run([sys.executable, example, str(spec), "--out", str(tmp_path / "out")],
-                          capture_output=True, text=True)
+    done = ablate(spec, tmp_path / "out")
     assert done.returncode != 0
     assert "sensors.camera.mount.rpy_deg" in done.stderr and "999" in done.stderr
     assert "Traceback" not in done.stderr
