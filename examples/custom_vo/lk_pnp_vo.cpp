@@ -27,29 +27,42 @@ VoResult LkPnpVo::process(const StereoFrame& frame) {
   }
   // Corners of the previous left image, followed into the previous right and the current left.
   std::vector<cv::Point2f> corners, in_right, in_current;
-  cv::goodFeaturesToTrack(prev_left, corners, options_.max_corners, 0.01,
-                          options_.min_corner_distance_px);
+  // Corners bucketed over a 4 x 4 grid (as libviso2 buckets its features): without it the
+  // strongest corners of the image, the glints of rippled water, crowd out the bank's.
+  const int cells = 4;
+  for (int row = 0; row < cells; ++row)
+    for (int col = 0; col < cells; ++col) {
+      const cv::Rect cell(col * prev_left.cols / cells, row * prev_left.rows / cells,
+                          prev_left.cols / cells, prev_left.rows / cells);
+      std::vector<cv::Point2f> found;
+      cv::goodFeaturesToTrack(prev_left(cell), found, options_.max_corners / (cells * cells), 0.01,
+                              options_.min_corner_distance_px);
+      for (const cv::Point2f& p : found) corners.emplace_back(p.x + cell.x, p.y + cell.y);
+    }
   if (corners.size() < 10) {
     r.reason = "too few corners";
     return r;
   }
-  std::vector<unsigned char> ok_right, ok_current, ok_back;
+  std::vector<unsigned char> ok_right, ok_current, ok_back, ok_since;
   std::vector<float> error;
-  std::vector<cv::Point2f> back_in_left;
+  std::vector<cv::Point2f> back_in_left, back_in_prev;
   cv::calcOpticalFlowPyrLK(prev_left, prev_right, corners, in_right, ok_right, error);
   cv::calcOpticalFlowPyrLK(prev_left, frame.left, corners, in_current, ok_current, error);
-  // The stereo match followed back into the left image must land where it started: water,
-  // sky and repeated texture give matches that do not.
+  // Each match followed back must land where it started (the forward-backward check of Kalal
+  // et al. 2010): water, sky and repeated texture give stereo matches that do not, and glints
+  // on rippled water, which move with the wind and not with the scene, give tracks that do not.
   cv::calcOpticalFlowPyrLK(prev_right, prev_left, in_right, back_in_left, ok_back, error);
+  cv::calcOpticalFlowPyrLK(frame.left, prev_left, in_current, back_in_prev, ok_since, error);
   // Points of the previous left camera (Z = fx B / disparity) and where they are now.
   const auto& c = rig_.camera;
   std::vector<cv::Point3f> points;
   std::vector<cv::Point2f> pixels;
   for (std::size_t i = 0; i < corners.size(); ++i) {
     const double disparity = corners[i].x - in_right[i].x;
-    if (!ok_right[i] || !ok_current[i] || !ok_back[i] ||
+    if (!ok_right[i] || !ok_current[i] || !ok_back[i] || !ok_since[i] ||
         std::abs(corners[i].y - in_right[i].y) > 1.0 ||
-        cv::norm(back_in_left[i] - corners[i]) > 0.5 || disparity < 2.0)
+        cv::norm(back_in_left[i] - corners[i]) > 0.5 ||
+        cv::norm(back_in_prev[i] - corners[i]) > 0.5 || disparity < 2.0)
       continue;
     const double z = c.fx * rig_.baseline_m / disparity;
     points.emplace_back((corners[i].x - c.cx) * z / c.fx, (corners[i].y - c.cy) * z / c.fy, z);

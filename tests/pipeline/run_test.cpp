@@ -314,16 +314,17 @@ TEST(Run, WholeDischargeMeasurementMission) {
   fs::remove_all(out);
 }
 
-// The end-to-end acceptance run: a straight calm-water leg (16 m at 0.5 m/s
-// past the river reach, two 6.5 m sections; 263 frames at the Bumblebee2's
-// 8.2 Hz) through every stage, checked against the data contract of
-// docs/design.md and for sane values, with the shipped defaults.
-TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
+// The end-to-end acceptance run: a straight leg (16 m at 0.5 m/s past the river reach, two
+// 6.5 m sections; 263 frames at the Bumblebee2's 8.2 Hz) through every stage, checked against
+// the data contract of docs/design.md and for sane values, with the shipped defaults.
+TEST(RunEndToEnd, StraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   // The shipped river_crossing scenario (both sparse VOs, the smoother, every camera effect of
-  // the defaults) on a straight calm leg: only the mission and its length are changed.
+  // the defaults, the paper's breeze on the water) on a straight leg: only the mission and its
+  // length are changed.
   const fs::path out = temp_dir("e2e");
   Scenario sc = load_scenario(kRunSourceDir / "scenarios/river_crossing.yaml");
-  ASSERT_EQ(sc.water.waves.model, sim::WaveModel::kCalm);
+  ASSERT_EQ(sc.water.waves.model, sim::WaveModel::kCalm);  // no swell: the breeze's ripples only
+  ASSERT_GT(sc.water.wind.speed_mps, 0.0);
   ASSERT_EQ(sc.pipeline.vo, (std::vector<std::string>{"sparse", "sparse_kf"}));
   sc.mission.type = sim::MissionType::kStraight;
   sc.mission.speed_mps = 0.5;
@@ -409,8 +410,11 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
   // p = 0.39). With the skeleton trees and their alpha-tested leaf cards: sparse_kf 0.0115 m/m,
   // length -0.4 %, 3D RMSE 0.61 %; sparse 0.0504 m/m, length -2.1 % (0.0130-0.0147 and 0.55-0.65 %
   // for versions with more cards; leaf edges alias: with 4x MSAA 0.0052, see
-  // docs/renderer-and-scenes.md, Trees). The bounds sit 30 % above the first version's figures
-  // (0.0130, 0.55 %), about 45 % above the skeleton trees' (0.0115, 0.61 %).
+  // docs/renderer-and-scenes.md, Trees). On that calm water the bounds were sparse_kf 0.0169 m/m,
+  // +-3 % and 0.72 %, sparse 0.061 m/m. With the paper's breeze rippling the water (4.4 m/s,
+  // shelter 0.25, as on the survey): sparse_kf 0.0579 m/m, length -5.5 %, 3D RMSE 3.38 %;
+  // sparse 0.0816 m/m, length +0.0 % (the ripples halve the inliers). The bounds sit 30 % above
+  // those; sparse's length keeps the calm bound.
   auto mean_ep = [&](const char* algo) {
     return m["algorithms"][algo]["sections"]["p_m_per_m"]["mean"].get<double>();
   };
@@ -423,11 +427,11 @@ TEST(RunEndToEnd, CalmStraightLegMeetsTheDataContractAndTheAccuracyBounds) {
       "3D RMSE %.2f %%\n",
       mean_ep("sparse"), length_error_pct("sparse"), mean_ep("sparse_kf"),
       length_error_pct("sparse_kf"), kf["track"]["rmse_3d_pct"].get<double>());
-  EXPECT_LT(mean_ep("sparse_kf"), 0.0169);
+  EXPECT_LT(mean_ep("sparse_kf"), 0.075);
   EXPECT_GT(mean_ep("sparse_kf"), 0.0);
-  EXPECT_LT(std::abs(length_error_pct("sparse_kf")), 3.0);  // the twin-fidelity issue's +-3 %
-  EXPECT_LT(kf["track"]["rmse_3d_pct"].get<double>(), 0.72);
-  EXPECT_LT(mean_ep("sparse"), 0.061);
+  EXPECT_LT(std::abs(length_error_pct("sparse_kf")), 7.2);
+  EXPECT_LT(kf["track"]["rmse_3d_pct"].get<double>(), 4.4);
+  EXPECT_LT(mean_ep("sparse"), 0.106);
   EXPECT_GT(mean_ep("sparse"), 0.0);
   EXPECT_LT(std::abs(length_error_pct("sparse")), 3.4);
   std::istringstream sections(slurp(out / "sections.csv"));
