@@ -262,3 +262,51 @@ def test_the_ablation_example_reports_a_bad_scenario_key_as_the_cli_does(tmp_pat
     assert "sensors.camera.mount.rpy_deg" in done.stderr and "999" in done.stderr
     assert "Traceback" not in done.stderr
     assert not (tmp_path / "out" / "tiny" / "fast").exists()
+
+
+def test_the_yaw_example_sets_both_truths_against_the_paper(tmp_path):
+    """examples/sweeps/yaw_variability.py on the tiny grid: the camera's pool is the merged
+    sections, the prism's pool is `driftlab eval --reference-point` of each run, its Eq. (13) fit
+    is the C++ regression's where both see the same sections, and the table carries each pool's
+    halves."""
+    import importlib.util
+    path = os.path.join(SOURCE, "examples", "sweeps", "yaw_variability.py")
+    spec = importlib.util.spec_from_file_location("yaw_variability", path)
+    yaw = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(yaw)
+    out = tmp_path / "yaw"
+    done = subprocess.run([sys.executable, path, "--sweep", TINY_GRID, "--set",
+                           "pipeline.max_frames=80", "--set", "eval.section_length_m=0.3", "--out",
+                           str(out), "--jobs", "2"],
+                          check=True, capture_output=True, text=True)
+    for suffix in ("md", "csv"):
+        assert (out / f"yaw_variability.{suffix}").stat().st_size > 0
+    assert (out / "yaw_variability.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    import pandas
+    pooled = pandas.read_csv(out / "yaw_variability.csv")
+    merged = driftlab.sweep.table(out, "sections")
+    camera = pooled[pooled["truth"] == "camera"]
+    assert len(camera) == len(merged[merged["algorithm"] == "sparse"].dropna(
+        subset=["p_m_per_m", *yaw.COVARIATES]))
+    jobs = sorted(os.listdir(out / "prism"))
+    assert jobs == sorted(merged["job"].unique())
+    # A lever arm moves the truth in the turns: the prism's errors are not the camera's.
+    prism = pooled[pooled["truth"] == "prism"]
+    assert len(prism) > 0 and not numpy.allclose(
+        sorted(prism["p_m_per_m"]), sorted(camera["p_m_per_m"]))
+    # The hand-written OLS against the C++ regression of one run's sections (its metrics.json).
+    folder = out / "prism" / jobs[-1]   # a job of the 20 deg weave: h varies
+    sections = pandas.read_csv(folder / "sections.csv")
+    fit, r2 = yaw.ols(sections.dropna(subset=["p_m_per_m", *yaw.COVARIATES]))
+    with open(folder / "metrics.json") as f:
+        regression = json.load(f)["algorithms"]["sparse"]["regression"]
+    assert r2 == pytest.approx(regression["r2"], rel=1e-9)
+    for name, (beta, se, t) in fit.items():
+        c = regression["coefficients"][name]
+        assert beta == pytest.approx(c["estimate"], rel=1e-6, abs=1e-12)
+        assert t == pytest.approx(c["t"], rel=1e-6)
+    # The table: the paper's row, then each pool's halves as halves() gives them.
+    for name, pool in (("camera", camera), ("prism", prism)):
+        low, high, _ = yaw.halves(pool)
+        assert f"| twin, sparse, {name} | {len(pool)} |" in done.stdout
+        assert f"{low:.3f} / {high:.3f}" in done.stdout
