@@ -64,12 +64,15 @@ def prism_sections(folder, job, prism):
     if not os.path.exists(os.path.join(out, "sections.csv")):
         with open(os.path.join(run, "scenario.resolved.yaml")) as f:
             e = yaml.safe_load(f)["eval"]
-        subprocess.run([_paths.cli(), "eval", "--gt", os.path.join(run, "groundtruth.tum"),
-                        "--est", os.path.join(run, "estimates", "sparse.tum"),
-                        "--covariates", os.path.join(run, "frames.csv"), "--vo", "sparse",
-                        "--align", e["align"], "--section-length", str(e["section_length_m"]),
-                        "--reference-point", prism, "--name", "sparse", "--out", out,
-                        "--force"], check=True, stdout=subprocess.DEVNULL)
+        command = [_paths.cli(), "eval", "--gt", os.path.join(run, "groundtruth.tum"),
+                   "--est", os.path.join(run, "estimates", "sparse.tum"),
+                   "--covariates", os.path.join(run, "frames.csv"), "--vo", "sparse",
+                   "--align", e["align"], "--section-length", str(e["section_length_m"]),
+                   "--reference-point", prism, "--name", "sparse", "--out", out, "--force"]
+        done = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                              text=True)
+        if done.returncode != 0:   # driftlab eval names the flag and value; it writes nothing
+            raise driftlab.Error(f"{run}: driftlab eval at the prism: {done.stderr.strip()}")
     return pandas.read_csv(os.path.join(out, "sections.csv"), float_precision="round_trip")
 
 
@@ -140,11 +143,21 @@ def plot(pools, path):
 
 def main():
     a = arguments()
+    try:
+        study(a)
+    except driftlab.Error as e:   # a bad sweep, key or prism: the message, no traceback
+        sys.exit(f"yaw_variability.py: {e}")
+
+
+def study(a):
     print(driftlab.sweep.plan(a.sweep, a.out, set=a.set, force=True))
     print(driftlab.sweep.run(a.out, jobs=a.jobs))
     driftlab.sweep.merge(a.out)
     sections = driftlab.sweep.table(a.out, "sections")
     exact = sections[sections["algorithm"] == "sparse"]
+    if exact.empty:
+        raise driftlab.Error(f"{a.out}: no run has a `sparse` estimate (pipeline.vo); the "
+                             "paper's h is the sparse VO's covariate")
     prism = [prism_sections(a.out, job, a.prism).assign(job=job) for job in exact["job"].unique()]
     import pandas
     pools = {"camera": exact.dropna(subset=["p_m_per_m", *COVARIATES]),

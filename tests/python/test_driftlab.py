@@ -310,3 +310,27 @@ def test_the_yaw_example_sets_both_truths_against_the_paper(tmp_path):
         low, high, _ = yaw.halves(pool)
         assert f"| twin, sparse, {name} | {len(pool)} |" in done.stdout
         assert f"{low:.3f} / {high:.3f}" in done.stdout
+
+
+def test_the_yaw_example_reports_bad_input_without_a_traceback_or_half_written_files(tmp_path):
+    path = os.path.join(SOURCE, "examples", "sweeps", "yaw_variability.py")
+    # A key the base scenario does not have: the sweep's own message, nothing planned.
+    out = tmp_path / "badkey"
+    done = subprocess.run([sys.executable, path, "--sweep", TINY_GRID, "--set",
+                           "pipeline.max_frame=8", "--out", str(out)],
+                          capture_output=True, text=True)
+    assert done.returncode != 0
+    assert "Traceback" not in done.stderr
+    assert "pipeline.max_frame" in done.stderr
+    assert not (out / "manifest.jsonl").exists()
+    # A prism that is not X,Y,Z: driftlab eval's message naming the flag and the value; no
+    # prism evaluation and no table written.
+    out = tmp_path / "badprism"
+    done = subprocess.run([sys.executable, path, "--sweep", TINY_GRID, "--set",
+                           "pipeline.max_frames=8", "--prism", "0.5,0.5", "--out", str(out),
+                           "--jobs", "2"], capture_output=True, text=True)
+    assert done.returncode != 0
+    assert "Traceback" not in done.stderr
+    assert "--reference-point" in done.stderr and "0.5,0.5" in done.stderr
+    assert not (out / "prism").exists()
+    assert not (out / "yaw_variability.md").exists()
